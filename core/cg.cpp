@@ -1,0 +1,84 @@
+#include "cg.hpp"
+
+#include <cmath>
+
+#include "../kernels/vector_ops.hpp"
+#include "profile.hpp"
+
+namespace tresca {
+
+const char* to_string(SolveReason r) {
+  switch (r) {
+    case SolveReason::converged: return "converged";
+    case SolveReason::max_iterations: return "max_iterations";
+    case SolveReason::breakdown: return "breakdown";
+    case SolveReason::non_finite: return "non_finite";
+  }
+  return "?";
+}
+
+SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, real* x, const CGOptions& opt,
+               CGWorkspace& ws) {
+  const index n = A.size();
+  ws.r.resize(n);
+  ws.z.resize(n);
+  ws.p.resize(n);
+  ws.q.resize(n);
+  real *r = ws.r.data(), *z = ws.z.data(), *p = ws.p.data(), *q = ws.q.data();
+  SolveStats st;
+  st.rhs_norm = norm2(n, b);
+  if (opt.zero_initial_guess) {
+    fill(n, 0, x);
+    copy(n, b, r);
+  } else {
+    A.apply(x, q);
+    copy(n, b, r);
+    axpy(n, -1, q, r);
+  }
+  real rr = dot(n, r, r);
+  st.initial_residual = st.residual = std::sqrt(rr);
+  const real target = std::max(opt.rtol * st.rhs_norm, opt.atol);
+  if (!std::isfinite(rr)) {
+    st.reason = SolveReason::non_finite;
+    return st;
+  }
+  if (st.residual <= target) return st;
+  auto precondition = [&] {
+    if (M)
+      M->apply(r, z);
+    else
+      copy(n, r, z);
+  };
+  precondition();
+  copy(n, z, p);
+  real rz = dot(n, r, z);
+  for (int it = 1; it <= opt.max_iterations; ++it) {
+    if (!(rz > 0)) {
+      st.reason = std::isfinite(rz) ? SolveReason::breakdown : SolveReason::non_finite;
+      return st;
+    }
+    A.apply(p, q);
+    const real pq = dot(n, p, q);
+    if (!(pq > 0)) {
+      st.reason = std::isfinite(pq) ? SolveReason::breakdown : SolveReason::non_finite;
+      return st;
+    }
+    const real alpha = rz / pq;
+    rr = cg_update(n, alpha, p, q, x, r);
+    st.iterations = it;
+    st.residual = std::sqrt(rr);
+    if (!std::isfinite(rr)) {
+      st.reason = SolveReason::non_finite;
+      return st;
+    }
+    if (st.residual <= target) return st;
+    precondition();
+    const real rz_new = dot(n, r, z);
+    xpay(n, z, rz_new / rz, p);
+    rz = rz_new;
+  }
+  st.reason = SolveReason::max_iterations;
+  return st;
+}
+
+}  // namespace tresca

@@ -1,0 +1,45 @@
+// Preconditioned conjugate gradients for SPD A with SPD preconditioner M ≈ A^{-1}.
+//
+// Stops when ||r|| <= max(rtol*||b||, atol) (Euclidean norm of the true
+// recursive residual), or returns the reason it could not: max_iterations,
+// breakdown (p.Ap <= 0 or r.z <= 0: operator or preconditioner not SPD), or
+// non_finite (NaN/Inf appeared). It never loops beyond max_iterations.
+//
+// Per iteration: 1 apply of A, 1 of M, 2 dots + 1 fused update + 1 xpay:
+// vector traffic about 112 bytes and 14 flops per entry besides A and M.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "operator.hpp"
+
+namespace tresca {
+
+enum class SolveReason { converged, max_iterations, breakdown, non_finite };
+const char* to_string(SolveReason r);
+
+struct SolveStats {
+  int iterations = 0;
+  real residual = 0;          // final ||r||
+  real initial_residual = 0;  // ||b - A x0||
+  real rhs_norm = 0;          // ||b||
+  SolveReason reason = SolveReason::converged;
+  bool ok() const { return reason == SolveReason::converged; }
+};
+
+struct CGOptions {
+  real rtol = 1e-10;
+  real atol = 0;
+  int max_iterations = 1000;
+  bool zero_initial_guess = true;  // otherwise x holds the initial guess
+};
+
+// Work vectors kept by the caller so repeated solves do not allocate.
+struct CGWorkspace {
+  std::vector<real> r, z, p, q;
+};
+
+SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, real* x, const CGOptions& opt,
+               CGWorkspace& ws);
+
+}  // namespace tresca

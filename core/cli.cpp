@@ -1,0 +1,135 @@
+#include "cli.hpp"
+
+#include <omp.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+namespace tresca {
+
+namespace {
+[[noreturn]] void fail(const std::string& m) { throw std::invalid_argument(m); }
+}  // namespace
+
+Args::Args(int argc, char** argv, const std::set<std::string>& flags, const std::set<std::string>& switches) {
+  for (int i = 1; i < argc; ++i) {
+    std::string k = argv[i];
+    std::string v;
+    const auto eq = k.find('=');
+    const bool inline_value = k.rfind("--", 0) == 0 && eq != std::string::npos;
+    if (inline_value) {
+      v = k.substr(eq + 1);
+      k = k.substr(0, eq);
+    }
+    if (switches.count(k)) {
+      if (inline_value) fail("option " + k + " takes no value");
+      values_[k] = "1";
+    } else if (flags.count(k)) {
+      if (!inline_value) {
+        if (i + 1 >= argc) fail("option " + k + " needs a value");
+        v = argv[++i];
+      }
+      values_[k] = v;
+    } else {
+      fail("unknown option '" + k + "' (see --help)");
+    }
+  }
+}
+
+std::string Args::str(const std::string& k, const std::string& def) const {
+  auto it = values_.find(k);
+  return it == values_.end() ? def : it->second;
+}
+
+double Args::real_value(const std::string& k, double def) const {
+  if (!has(k)) return def;
+  const std::string s = str(k);
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+    fail("option " + k + ": '" + s + "' is not a finite number");
+  return v;
+}
+
+long long Args::int_value(const std::string& k, long long def) const {
+  if (!has(k)) return def;
+  const std::string s = str(k);
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(s.c_str(), &end, 10);
+  if (s.empty() || *end != '\0' || errno == ERANGE) fail("option " + k + ": '" + s + "' is not an integer");
+  return v;
+}
+
+ProblemSpec spec_from_args(const Args& a, int default_level) {
+  if (a.has("--level") && a.has("--dims")) fail("give either --level or --dims, not both");
+  ProblemSpec s;
+  if (a.has("--dims")) {
+    const std::string d = a.str("--dims");
+    long long e[3];
+    char x1, x2;
+    std::istringstream is(d);
+    if (!(is >> e[0] >> x1 >> e[1] >> x2 >> e[2]) || x1 != 'x' || x2 != 'x' || !is.eof() ||
+        d.find_first_not_of("0123456789x") != std::string::npos)
+      fail("--dims '" + d + "' is malformed (expected EXxEYxEZ, e.g. 16x8x8)");
+    if (e[0] < 1 || e[1] < 1 || e[2] < 1) fail("--dims '" + d + "': every element count must be >= 1");
+    s = spec_for_dims(e[0], e[1], e[2]);
+  } else {
+    const long long L = a.int_value("--level", default_level);
+    if (L < 0 || L > 20) fail("--level " + std::to_string(L) + " is out of range (0..20)");
+    s = spec_for_level(int(L));
+  }
+  s.E = a.real_value("--E", s.E);
+  s.nu = a.real_value("--nu", s.nu);
+  s.phi = a.real_value("--phi", s.phi);
+  validate(s);
+  check_memory(s);
+  return s;
+}
+
+std::vector<int> parse_level_range(const std::string& s) {
+  int a = 0, b = 0;
+  char dash = 0;
+  std::istringstream is(s);
+  if (!(is >> a)) fail("level range '" + s + "' is malformed (expected e.g. 1-8)");
+  b = a;
+  if (is >> dash) {
+    if (dash != '-' || !(is >> b)) fail("level range '" + s + "' is malformed (expected e.g. 1-8)");
+  }
+  if (!is.eof() && is.peek() != EOF) fail("level range '" + s + "' is malformed (expected e.g. 1-8)");
+  if (a < 0 || b > 20 || a > b) fail("level range '" + s + "' must satisfy 0 <= first <= last <= 20");
+  std::vector<int> r;
+  for (int l = a; l <= b; ++l) r.push_back(l);
+  return r;
+}
+
+void check_memory(const ProblemSpec& s) {
+  const double need = estimated_memory_bytes(s);
+  const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  if (have > 0 && need > 0.9 * have) {
+    std::ostringstream os;
+    os << "mesh " << dims_string(s) << " needs about " << need / 1e9 << " GB, more than this machine's "
+       << have / 1e9 << " GB";
+    fail(os.str());
+  }
+}
+
+int apply_threads(const Args& a) {
+  if (a.has("--threads")) {
+    const long long t = a.int_value("--threads", 1);
+    if (t < 1 || t > 1024) fail("--threads " + std::to_string(t) + " must be in 1..1024");
+    omp_set_num_threads(int(t));
+  }
+  return omp_get_max_threads();
+}
+
+std::string dims_string(const ProblemSpec& s) {
+  return std::to_string(s.ex) + "x" + std::to_string(s.ey) + "x" + std::to_string(s.ez);
+}
+
+}  // namespace tresca

@@ -1,0 +1,37 @@
+// Minimal command-line parsing shared by the drivers. Every error is a
+// std::invalid_argument whose message names the offending flag or value;
+// drivers print it on one line and exit with status 2.
+#pragma once
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "problem.hpp"
+
+namespace tresca {
+
+class Args {
+ public:
+  // flags: options taking a value ("--level"); switches: options without ("--quiet")
+  Args(int argc, char** argv, const std::set<std::string>& flags, const std::set<std::string>& switches);
+  bool has(const std::string& k) const { return values_.count(k) > 0; }
+  std::string str(const std::string& k, const std::string& def = "") const;
+  double real_value(const std::string& k, double def) const;
+  long long int_value(const std::string& k, long long def) const;
+
+ private:
+  std::map<std::string, std::string> values_;
+};
+
+// "--level L" or "--dims AxBxC" (exactly one; default level), plus --E, --nu, --phi.
+ProblemSpec spec_from_args(const Args& a, int default_level);
+// "A-B" or "A" → inclusive range of levels
+std::vector<int> parse_level_range(const std::string& s);
+// throws if the estimated memory of a run exceeds the machine's physical memory
+void check_memory(const ProblemSpec& s);
+// --threads N (else OMP_NUM_THREADS / all cores); returns the thread count in use
+int apply_threads(const Args& a);
+std::string dims_string(const ProblemSpec& s);
+
+}  // namespace tresca

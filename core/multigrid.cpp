@@ -1,0 +1,204 @@
+#include "multigrid.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "../kernels/vector_ops.hpp"
+#include "profile.hpp"
+
+namespace tresca {
+
+namespace {
+GridDims coarsen(const GridDims& g) {
+  GridDims c = g;
+  c.ex = (g.ex + 1) / 2;
+  c.ey = (g.ey + 1) / 2;
+  c.ez = (g.ez + 1) / 2;
+  return c;
+}
+}  // namespace
+
+Multigrid::Multigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt) : opt_(opt) {
+  GridDims g = fine;
+  for (;;) {
+    Level lv;
+    lv.A = ElasticityOperator(g, faces, E, nu);
+    const index n = lv.A.size();
+    lv.x.resize(n);
+    lv.b.resize(n);
+    lv.r.resize(n);
+    lv.d.resize(n);
+    const bool last = g.nodes() <= opt.coarse_nodes || (g.ex == 1 && g.ey == 1 && g.ez == 1);
+    if (!last) lv.to_coarse = build_transfer(g, coarsen(g));
+    levels_.push_back(std::move(lv));
+    if (last) break;
+    g = coarsen(g);
+  }
+  for (auto& lv : levels_) {
+    auto d = lv.A.diagonal();
+    lv.dinv.resize(d.size());
+    for (size_t i = 0; i < d.size(); ++i) lv.dinv[i] = 1 / d[i];
+    if (&lv != &levels_.back()) estimate_lmax(lv);
+  }
+  factor_coarse();
+}
+
+void Multigrid::estimate_lmax(Level& lv) {
+  // Lanczos through Jacobi-PCG: T_jj = 1/a_j + b_{j-1}/a_{j-1}, T_j,j+1 = sqrt(b_j)/a_j
+  const index n = lv.A.size();
+  std::vector<real> x(n, 0), r(n), z(n), p(n), q(n);
+  std::uint64_t s = 12345;
+  for (index i = 0; i < n; ++i) {
+    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+    r[i] = real((s >> 11) & 0xFFFFF) / real(0xFFFFF) - 0.5;
+  }
+  zero_constrained(lv.A.grid(), lv.A.faces(), r.data());
+  hadamard(n, lv.dinv.data(), r.data(), z.data());
+  copy(n, z.data(), p.data());
+  real rz = dot(n, r.data(), z.data());
+  std::vector<real> al, be;
+  const int its = 15;
+  for (int j = 0; j < its && rz > 0; ++j) {
+    lv.A.apply(p.data(), q.data());
+    const real a = rz / dot(n, p.data(), q.data());
+    cg_update(n, a, p.data(), q.data(), x.data(), r.data());
+    hadamard(n, lv.dinv.data(), r.data(), z.data());
+    const real rz_new = dot(n, r.data(), z.data());
+    al.push_back(a);
+    be.push_back(rz_new / rz);
+    xpay(n, z.data(), rz_new / rz, p.data());
+    rz = rz_new;
+  }
+  const int m = int(al.size());
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(m, m);
+  for (int j = 0; j < m; ++j) {
+    T(j, j) = 1 / al[j] + (j > 0 ? be[j - 1] / al[j - 1] : 0);
+    if (j + 1 < m) T(j, j + 1) = T(j + 1, j) = std::sqrt(be[j]) / al[j];
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T, Eigen::EigenvaluesOnly);
+  // B terms of the Newton preconditioner (PSD, 2x2 blocks) keep D^{-1}(K+B) below max(lmax, 2)
+  lv.lmax = 1.15 * std::max(es.eigenvalues().maxCoeff(), real(2));
+}
+
+void Multigrid::factor_coarse() {
+  SparseMatrix A = assemble(levels_.back().A);
+  coarse_.compute(A);
+  if (coarse_.info() != Eigen::Success) throw std::runtime_error("multigrid: coarse factorisation failed");
+  cb_.resize(A.rows());
+  cx_.resize(A.rows());
+}
+
+void Multigrid::set_bottom_block(const std::vector<real>& B) {
+  levels_[0].A.set_bottom_block(B);
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) {
+    const Level& f = levels_[l];
+    Level& c = levels_[l + 1];
+    const std::vector<real>& Bf = f.A.bottom_block();
+    if (Bf.empty()) {
+      c.A.set_bottom_block({});
+      continue;
+    }
+    const GridDims &fg = f.A.grid(), &cg = c.A.grid();
+    const index Mf = fg.nx() * fg.ny(), Mc = cg.nx() * cg.ny();
+    const Interp1D &X = f.to_coarse.axis[0], &Y = f.to_coarse.axis[1];
+    std::vector<real> Bc(4 * Mc, 0.0);
+    for (int fld = 0; fld < 4; ++fld)
+      for (index jy = 0; jy < cg.ny(); ++jy)
+        for (index jx = 0; jx < cg.nx(); ++jx) {
+          real s = 0;
+          for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky)
+            for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx)
+              s += Y.tw[ky] * X.tw[kx] * Bf[fld * Mf + X.tf[kx] + fg.nx() * Y.tf[ky]];
+          Bc[fld * Mc + jx + cg.nx() * jy] = s;
+        }
+    c.A.set_bottom_block(std::move(Bc));
+  }
+  for (auto& lv : levels_) {
+    auto d = lv.A.diagonal();
+    for (size_t i = 0; i < d.size(); ++i) lv.dinv[i] = 1 / d[i];
+  }
+  factor_coarse();
+}
+
+void Multigrid::smooth(int l, bool zero_guess) const {
+  const Level& lv = levels_[l];
+  const index n = lv.A.size();
+  ScopedTimer t(Kernel::smoother);
+  const real lmax = lv.lmax, lmin = lmax / opt_.range;
+  const real theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
+  real* x = lv.x.data();
+  real* r = lv.r.data();
+  real* d = lv.d.data();
+  auto residual = [&] {
+    lv.A.apply(x, r);
+    xpay(n, lv.b.data(), -1, r);  // r = b - A x
+  };
+  if (zero_guess) {
+    fill(n, 0, x);
+    copy(n, lv.b.data(), r);
+  } else {
+    residual();
+  }
+  fill(n, 0, d);
+  cheb_update(n, 0, 1 / theta, lv.dinv.data(), r, d, x);
+  real rho = 1 / sigma;
+  for (int k = 1; k < opt_.degree; ++k) {
+    residual();
+    const real rho_new = 1 / (2 * sigma - rho);
+    cheb_update(n, rho_new * rho, 2 * rho_new / delta, lv.dinv.data(), r, d, x);
+    rho = rho_new;
+  }
+}
+
+void Multigrid::vcycle(int l) const {
+  const Level& lv = levels_[l];
+  if (l + 1 == int(levels_.size())) {
+    ScopedTimer t(Kernel::coarse_solve);
+    const index n = lv.A.size();
+    for (index i = 0; i < n; ++i) cb_[i] = lv.b[i];
+    cx_ = coarse_.solve(cb_);
+    for (index i = 0; i < n; ++i) lv.x[i] = cx_[i];
+    return;
+  }
+  const index n = lv.A.size();
+  const Level& c = levels_[l + 1];
+  smooth(l, true);
+  lv.A.apply(lv.x.data(), lv.r.data());
+  xpay(n, lv.b.data(), -1, lv.r.data());
+  {
+    const double nf = double(n);
+    ScopedTimer t(Kernel::restrict_, nf * 8 * 1.3, nf * 2 * 8 / 8 * 8);
+    restrict_to_coarse(lv.to_coarse, 3, lv.r.data(), c.b.data());
+    zero_constrained(c.A.grid(), c.A.faces(), c.b.data());
+  }
+  vcycle(l + 1);
+  {
+    const double nf = double(n);
+    ScopedTimer t(Kernel::prolongate, nf * 8 * 1.3, nf * 15);
+    prolongate(lv.to_coarse, 3, c.x.data(), lv.d.data());
+    zero_constrained(lv.A.grid(), lv.A.faces(), lv.d.data());
+  }
+  axpy(n, 1, lv.d.data(), lv.x.data());
+  smooth(l, false);
+}
+
+void Multigrid::apply(const real* r, real* z) const {
+  const index n = size();
+  copy(n, r, levels_[0].b.data());
+  vcycle(0);
+  copy(n, levels_[0].x.data(), z);
+}
+
+std::string Multigrid::describe() const {
+  std::ostringstream os;
+  os << levels_.size() << " levels:";
+  for (const auto& lv : levels_) {
+    const GridDims& g = lv.A.grid();
+    os << " " << g.ex << "x" << g.ey << "x" << g.ez;
+  }
+  return os.str();
+}
+
+}  // namespace tresca

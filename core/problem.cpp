@@ -1,0 +1,115 @@
+#include "problem.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace tresca {
+
+namespace {
+[[noreturn]] void fail(const std::string& what) { throw std::invalid_argument(what); }
+}  // namespace
+
+std::array<index, 3> level_dims(int level) {
+  const double s = std::pow(2.0, level / 2.0);
+  return {index(std::ceil(4 * s - 1e-9)), index(std::ceil(2 * s - 1e-9)), index(std::ceil(2 * s - 1e-9))};
+}
+
+ProblemSpec spec_for_level(int level) {
+  if (level < 0 || level > 20) {
+    std::ostringstream os;
+    os << "mesh level " << level << " is out of range (0..20)";
+    fail(os.str());
+  }
+  ProblemSpec s;
+  s.level = level;
+  auto d = level_dims(level);
+  s.ex = d[0];
+  s.ey = d[1];
+  s.ez = d[2];
+  return s;
+}
+
+ProblemSpec spec_for_dims(index ex, index ey, index ez) {
+  ProblemSpec s;
+  s.ex = ex;
+  s.ey = ey;
+  s.ez = ez;
+  return s;
+}
+
+void validate(const ProblemSpec& s) {
+  std::ostringstream os;
+  if (s.ex < 1 || s.ey < 1 || s.ez < 1) {
+    os << "element counts " << s.ex << "x" << s.ey << "x" << s.ez << " must all be >= 1";
+    fail(os.str());
+  }
+  if (!(s.E > 0) || !std::isfinite(s.E)) {
+    os << "Young's modulus E = " << s.E << " must be positive and finite";
+    fail(os.str());
+  }
+  if (!(s.nu > -1 && s.nu < 0.5)) {
+    os << "Poisson ratio nu = " << s.nu << " must lie in (-1, 0.5)";
+    fail(os.str());
+  }
+  if (!(s.phi >= 0) || !std::isfinite(s.phi)) {
+    os << "friction bound phi = " << s.phi << " must be >= 0 and finite";
+    fail(os.str());
+  }
+  if (!(s.lx > 0 && s.ly > 0 && s.lz > 0)) {
+    os << "box edges " << s.lx << " " << s.ly << " " << s.lz << " must be positive";
+    fail(os.str());
+  }
+  const double nodes = double(s.ex + 1) * double(s.ey + 1) * double(s.ez + 1);
+  if (nodes > 4e8) {
+    os << "mesh " << s.ex << "x" << s.ey << "x" << s.ez << " has " << nodes << " nodes, beyond what this code can address";
+    fail(os.str());
+  }
+}
+
+Problem make_problem(const ProblemSpec& spec) {
+  validate(spec);
+  Problem P;
+  P.spec = spec;
+  GridDims& g = P.grid;
+  g.ex = spec.ex;
+  g.ey = spec.ey;
+  g.ez = spec.ez;
+  g.lx = spec.lx;
+  g.ly = spec.ly;
+  g.lz = spec.lz;
+  g.x0 = spec.x0;
+  g.y0 = spec.y0;
+  g.z0 = spec.z0;
+  const index N = g.nodes();
+  P.load.assign(3 * N, 0.0);
+  // right face x = lx: quads in (y,z), area hy*hz
+  const real qr = g.hy() * g.hz() / 4;
+  for (index ez = 0; ez < g.ez; ++ez)
+    for (index ey = 0; ey < g.ey; ++ey)
+      for (int k = 0; k < 4; ++k) {
+        const index n = g.node(g.ex, ey + (k & 1), ez + (k >> 1));
+        for (int a = 0; a < 3; ++a) P.load[a * N + n] += spec.traction_right[a] * qr;
+      }
+  // top face z = lz: quads in (x,y), area hx*hy
+  const real qt = g.hx() * g.hy() / 4;
+  for (index ey = 0; ey < g.ey; ++ey)
+    for (index ex = 0; ex < g.ex; ++ex)
+      for (int k = 0; k < 4; ++k) {
+        const index n = g.node(ex + (k & 1), ey + (k >> 1), g.ez);
+        for (int a = 0; a < 3; ++a) P.load[a * N + n] += spec.traction_top[a] * qt;
+      }
+  for (index iz = 0; iz < g.nz(); ++iz)
+    for (index iy = 0; iy < g.ny(); ++iy)
+      for (int a = 0; a < 3; ++a) P.load[a * N + g.node(0, iy, iz)] = 0;
+  return P;
+}
+
+double estimated_memory_bytes(const ProblemSpec& s) {
+  const double n = double(s.ex + 1) * double(s.ey + 1) * double(s.ez + 1);
+  // about 40 fine-grid vectors of 3n doubles (two multigrid hierarchies, CG
+  // work vectors, solution and load) plus the coarse levels (1/7 more)
+  return 40.0 * 3 * n * 8 * (1 + 1.0 / 7);
+}
+
+}  // namespace tresca

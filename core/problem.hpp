@@ -1,0 +1,63 @@
+// The benchmark problem of the seed paper (method.md §1).
+//
+// Prism (0,2)x(0,1)x(0.1,1), E = 2.1e9, nu = 0.277, u = 0 on x = 0,
+// tractions (-5e8,0,0) on x = 2 and (0,0,-1e8) on z = 1 (consistent nodal
+// loads: each face quad gives traction*area/4 to its 4 nodes), rigid
+// foundation under the bottom face z = 0.1 (contact nodes: iz = 0, ix > 0),
+// Tresca bound phi per contact node.
+//
+// Mesh level l: ex = ceil(4*2^(l/2)), ey = ez = ceil(2*2^(l/2)); or explicit
+// element counts. Every value can be changed before calling make_problem.
+//
+// DATA LAYOUT: SoA fields over the grid (grid.hpp); contact node
+// c = (ix-1) + ex*iy for the bottom node (ix, iy, 0), p = ex*(ey+1).
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "../kernels/grid.hpp"
+#include "../kernels/types.hpp"
+
+namespace tresca {
+
+struct ProblemSpec {
+  int level = -1;                  // -1 when dims were given explicitly
+  index ex = 0, ey = 0, ez = 0;
+  real lx = 2, ly = 1, lz = 0.9;   // box edges
+  real x0 = 0, y0 = 0, z0 = 0.1;   // box origin
+  real E = 2.1e9, nu = 0.277;
+  std::array<real, 3> traction_right{-5e8, 0, 0};  // on x = x0 + lx
+  std::array<real, 3> traction_top{0, 0, -1e8};    // on z = z0 + lz
+  real phi = 1;                    // Tresca bound per contact node (a force)
+};
+
+// Element counts of mesh level l (method.md §1).
+std::array<index, 3> level_dims(int level);
+// Throws std::invalid_argument naming the value if the level is out of range.
+ProblemSpec spec_for_level(int level);
+ProblemSpec spec_for_dims(index ex, index ey, index ez);
+// Throws std::invalid_argument naming the offending value.
+void validate(const ProblemSpec& s);
+
+struct Problem {
+  ProblemSpec spec;
+  GridDims grid;
+  unsigned dirichlet_faces = kFaceX0;              // K: u = 0 on x = 0
+  unsigned interior_faces = kFaceX0 | kFaceZ0;     // K_ii: also the contact face
+  std::vector<real> load;                          // l, SoA, 3N
+  index contact_nodes() const { return grid.ex * grid.ny(); }
+  // grid node of contact node c
+  index contact_grid_node(index c) const { return grid.node(1 + c % grid.ex, c / grid.ex, 0); }
+  index nodes() const { return grid.nodes(); }
+  index dofs() const { return 3 * grid.nodes(); }
+  // unknown displacement dofs (all but the Dirichlet face)
+  index free_dofs() const { return 3 * (grid.nodes() - grid.ny() * grid.nz()); }
+};
+
+Problem make_problem(const ProblemSpec& spec);
+
+// Rough peak memory of a full tresca solve in bytes (for a warning before large runs).
+double estimated_memory_bytes(const ProblemSpec& s);
+
+}  // namespace tresca

@@ -1,0 +1,57 @@
+#include "profile.hpp"
+
+#include <omp.h>
+
+#include <cstdio>
+
+namespace tresca {
+
+namespace {
+ProfileEntry g_entries[int(Kernel::count)];
+}
+
+const char* kernel_name(Kernel k) {
+  static const char* names[] = {"apply (K x)", "apply (bottom block)", "diagonal", "smoother (Chebyshev)",
+                                "prolongation", "restriction", "coarse solve", "vector updates",
+                                "contact maps", "inner CG (total)", "outer CG (total)"};
+  return names[int(k)];
+}
+
+double wall_time() { return omp_get_wtime(); }
+
+void profile_add(Kernel k, double seconds, double bytes, double flops) {
+  // called from the serial driver thread only (kernels parallelise inside)
+  ProfileEntry& e = g_entries[int(k)];
+  e.calls += 1;
+  e.seconds += seconds;
+  e.bytes += bytes;
+  e.flops += flops;
+}
+
+ProfileEntry profile_get(Kernel k) { return g_entries[int(k)]; }
+
+void profile_reset() {
+  for (auto& e : g_entries) e = ProfileEntry{};
+}
+
+std::string profile_table(double total) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-22s %10s %10s %7s %9s %9s\n", "kernel", "calls", "time [s]", "share",
+                "GB/s", "GFLOP/s");
+  out += line;
+  for (int i = 0; i < int(Kernel::count); ++i) {
+    const ProfileEntry& e = g_entries[i];
+    if (e.calls == 0) continue;
+    const bool nested = Kernel(i) == Kernel::inner_cg || Kernel(i) == Kernel::outer_cg;
+    std::snprintf(line, sizeof line, "%-22s %10lld %10.3f %6.1f%% %9s %9s\n", kernel_name(Kernel(i)), e.calls,
+                  e.seconds, total > 0 ? 100 * e.seconds / total : 0.0,
+                  nested || e.seconds <= 0 ? "-" : std::to_string(e.bytes / e.seconds * 1e-9).substr(0, 6).c_str(),
+                  nested || e.seconds <= 0 ? "-" : std::to_string(e.flops / e.seconds * 1e-9).substr(0, 6).c_str());
+    out += line;
+  }
+  out += "(inner/outer CG rows include the kernels above; their share overlaps)\n";
+  return out;
+}
+
+}  // namespace tresca

@@ -1,0 +1,42 @@
+// Per-kernel call counts, wall time, and modelled bytes/flops (the models are
+// stated in each kernel's header). `tresca --profile` prints the table.
+// Timers are cheap (omp_get_wtime) and always on.
+#pragma once
+#include <string>
+
+#include "../kernels/types.hpp"
+
+namespace tresca {
+
+enum class Kernel : int {
+  apply, apply_boundary, diagonal, smoother, prolongate, restrict_, coarse_solve, vector, contact_maps,
+  inner_cg, outer_cg, count
+};
+const char* kernel_name(Kernel k);
+
+struct ProfileEntry {
+  long long calls = 0;
+  double seconds = 0, bytes = 0, flops = 0;
+};
+
+void profile_add(Kernel k, double seconds, double bytes, double flops);
+ProfileEntry profile_get(Kernel k);
+void profile_reset();
+// Table with calls, time, share of `total_seconds`, GB/s and GFLOP/s.
+std::string profile_table(double total_seconds);
+
+double wall_time();
+
+class ScopedTimer {
+ public:
+  ScopedTimer(Kernel k, double bytes = 0, double flops = 0) : k_(k), b_(bytes), f_(flops), t0_(wall_time()) {}
+  ~ScopedTimer() { profile_add(k_, wall_time() - t0_, b_, f_); }
+  ScopedTimer(const ScopedTimer&) = delete;
+  ScopedTimer& operator=(const ScopedTimer&) = delete;
+
+ private:
+  Kernel k_;
+  double b_, f_, t0_;
+};
+
+}  // namespace tresca

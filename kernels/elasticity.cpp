@@ -1,0 +1,231 @@
+#include "elasticity.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "element.hpp"
+
+namespace tresca {
+namespace {
+
+enum : std::uint8_t { kHasL = 1, kHasR = 2, kDropL = 4, kDropR = 8, kSelf = 16 };
+
+std::uint8_t axis_class(index i, index n, bool c_lo, bool c_hi) {
+  auto constrained = [&](index j) { return (c_lo && j == 0) || (c_hi && j == n - 1); };
+  std::uint8_t c = 0;
+  if (i > 0) c |= kHasL;
+  if (i < n - 1) c |= kHasR;
+  if (i > 0 && constrained(i - 1)) c |= kDropL;
+  if (i < n - 1 && constrained(i + 1)) c |= kDropR;
+  if (constrained(i)) c |= kSelf;
+  return c;
+}
+
+// Coupling of offset d in {-1,0,1} for a node of class c along one axis:
+// which element sides (0 = left element, node is its local 1; 1 = right
+// element, node is its local 0) contribute, and whether the neighbour is dropped.
+bool dropped(std::uint8_t c, int d) { return (d < 0 && (c & kDropL)) || (d > 0 && (c & kDropR)); }
+
+template <int W>
+inline void stencil_block(const StencilEntry* e, const StencilEntry* e_end, const real* x, real* y) {
+  real acc[W];
+  for (int l = 0; l < W; ++l) acc[l] = 0;
+  for (; e != e_end; ++e) {
+    const real* xp = x + e->off;
+    const real c = e->c;
+#pragma omp simd
+    for (int l = 0; l < W; ++l) acc[l] += c * xp[l];
+  }
+  for (int l = 0; l < W; ++l) y[l] = acc[l];
+}
+
+// y[i] = sum_e c_e x[i + off_e] for i in [i0, i1) (one output component).
+inline void stencil_range(const StencilEntry* e, const StencilEntry* e_end, const real* x, real* y, index i0,
+                          index i1) {
+  index i = i0;
+  for (; i + 32 <= i1; i += 32) stencil_block<32>(e, e_end, x + i, y + i);
+  for (; i + 8 <= i1; i += 8) stencil_block<8>(e, e_end, x + i, y + i);
+  for (; i < i1; ++i) stencil_block<1>(e, e_end, x + i, y + i);
+}
+
+}  // namespace
+
+ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, real E, real nu) {
+  ElasticityStencil k;
+  k.g = g;
+  k.faces = faces;
+  k.E = E;
+  k.nu = nu;
+  brick_stiffness(g.hx(), g.hy(), g.hz(), E, nu, k.Ke.data());
+  const index n[3] = {g.nx(), g.ny(), g.nz()};
+  const bool lo[3] = {bool(faces & kFaceX0), bool(faces & kFaceY0), bool(faces & kFaceZ0)};
+  const bool hi[3] = {bool(faces & kFaceX1), bool(faces & kFaceY1), bool(faces & kFaceZ1)};
+  for (int ax = 0; ax < 3; ++ax) {
+    k.cls[ax].resize(n[ax]);
+    for (index i = 0; i < n[ax]; ++i) k.cls[ax][i] = axis_class(i, n[ax], lo[ax], hi[ax]);
+  }
+  for (index i = 0; i < n[0]; ++i)
+    if (i == 0 || k.cls[0][i] != k.cls[0][i - 1]) k.run_begin.push_back(i);
+  k.run_begin.push_back(n[0]);
+
+  const index N = g.nodes();
+  k.slot.assign(32 * 32 * 32, -1);
+  k.first.push_back(0);
+  auto distinct = [](const std::vector<std::uint8_t>& v) {
+    std::vector<std::uint8_t> u(v);
+    std::sort(u.begin(), u.end());
+    u.erase(std::unique(u.begin(), u.end()), u.end());
+    return u;
+  };
+  for (std::uint8_t cx : distinct(k.cls[0]))
+    for (std::uint8_t cy : distinct(k.cls[1]))
+      for (std::uint8_t cz : distinct(k.cls[2])) {
+        const std::uint8_t c[3] = {cx, cy, cz};
+        // dense 27x3x3 stencil from the element matrices around the node
+        real S[27][3][3] = {};
+        for (int side = 0; side < 8; ++side) {  // side bit ax: 0 = element on the left, 1 = right
+          bool present = true;
+          int lnode[3];
+          for (int ax = 0; ax < 3; ++ax) {
+            const bool right = (side >> ax) & 1;
+            present = present && (right ? (c[ax] & kHasR) : (c[ax] & kHasL));
+            lnode[ax] = right ? 0 : 1;
+          }
+          if (!present) continue;
+          const int L = lnode[0] + 2 * lnode[1] + 4 * lnode[2];
+          for (int M = 0; M < 8; ++M) {
+            const int d[3] = {(M & 1) - lnode[0], ((M >> 1) & 1) - lnode[1], ((M >> 2) & 1) - lnode[2]};
+            if (dropped(cx, d[0]) || dropped(cy, d[1]) || dropped(cz, d[2])) continue;
+            const int di = (d[0] + 1) + 3 * (d[1] + 1) + 9 * (d[2] + 1);
+            for (int a = 0; a < 3; ++a)
+              for (int b = 0; b < 3; ++b) S[di][a][b] += k.Ke[24 * (3 * L + a) + 3 * M + b];
+          }
+        }
+        const std::int32_t s = std::int32_t(k.first.size() - 1) / 3;
+        k.slot[(cx * 32 + cy) * 32 + cz] = s;
+        real scale = 0;
+        for (int a = 0; a < 3; ++a) scale = std::max(scale, std::abs(S[13][a][a]));
+        for (int a = 0; a < 3; ++a) {
+          for (int di = 0; di < 27; ++di) {
+            const index dx = di % 3 - 1, dy = (di / 3) % 3 - 1, dz = di / 9 - 1;
+            for (int b = 0; b < 3; ++b) {
+              // exact cancellations leave round-off of order 1e-16*scale
+              if (std::abs(S[di][a][b]) <= 1e-12 * scale) continue;
+              k.entries.push_back({b * N + dx + g.nx() * (dy + g.ny() * dz), S[di][a][b]});
+            }
+          }
+          k.first.push_back(std::int32_t(k.entries.size()));
+          k.center.push_back(S[13][a][a]);
+        }
+      }
+  return k;
+}
+
+void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end) {
+  const GridDims& g = k.g;
+  const index nx = g.nx(), ny = g.ny(), N = g.nodes();
+  const index nruns = index(k.run_begin.size()) - 1;
+#pragma omp parallel for collapse(2) schedule(static)
+  for (index iz = z_begin; iz < z_end; ++iz)
+    for (index iy = 0; iy < ny; ++iy) {
+      const std::uint8_t cy = k.cls[1][iy], cz = k.cls[2][iz];
+      const index row = nx * (iy + ny * iz);
+      const bool row_fixed = (cy & kSelf) || (cz & kSelf);
+      for (index r = 0; r < nruns; ++r) {
+        const index i0 = k.run_begin[r], i1 = k.run_begin[r + 1];
+        const std::uint8_t cx = k.cls[0][i0];
+        if (row_fixed || (cx & kSelf)) {
+          for (int a = 0; a < 3; ++a)
+            for (index i = i0; i < i1; ++i) y[a * N + row + i] = x[a * N + row + i];
+          continue;
+        }
+        const std::int32_t s = k.slot[(cx * 32 + cy) * 32 + cz];
+        for (int a = 0; a < 3; ++a) {
+          const StencilEntry* e0 = k.entries.data() + k.first[3 * s + a];
+          const StencilEntry* e1 = k.entries.data() + k.first[3 * s + a + 1];
+          stencil_range(e0, e1, x + row, y + a * N + row, i0, i1);
+        }
+      }
+    }
+}
+
+void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end) {
+  const GridDims& g = k.g;
+  const index N = g.nodes();
+  for (index iz = z_begin; iz < z_end; ++iz)
+    for (index iy = 0; iy < g.ny(); ++iy)
+      for (index ix = 0; ix < g.nx(); ++ix)
+        for (int a = 0; a < 3; ++a) y[a * N + g.node(ix, iy, iz)] = 0;
+  for (index ez = 0; ez < g.ez; ++ez)
+    for (index ey = 0; ey < g.ey; ++ey)
+      for (index ex = 0; ex < g.ex; ++ex) {
+        index nodes[8];
+        bool fixed[8];
+        real xe[24], ye[24];
+        for (int L = 0; L < 8; ++L) {
+          const index ix = ex + (L & 1), iy = ey + ((L >> 1) & 1), iz = ez + ((L >> 2) & 1);
+          nodes[L] = g.node(ix, iy, iz);
+          fixed[L] = node_constrained(g, k.faces, ix, iy, iz) || iz < z_begin || iz >= z_end;
+          const bool c = node_constrained(g, k.faces, ix, iy, iz);
+          for (int a = 0; a < 3; ++a) xe[3 * L + a] = c ? 0 : x[a * N + nodes[L]];
+        }
+        for (int i = 0; i < 24; ++i) {
+          real s = 0;
+          for (int j = 0; j < 24; ++j) s += k.Ke[24 * i + j] * xe[j];
+          ye[i] = s;
+        }
+        for (int L = 0; L < 8; ++L)
+          if (!fixed[L])
+            for (int a = 0; a < 3; ++a) y[a * N + nodes[L]] += ye[3 * L + a];
+      }
+  for (index iz = z_begin; iz < z_end; ++iz)
+    for (index iy = 0; iy < g.ny(); ++iy)
+      for (index ix = 0; ix < g.nx(); ++ix)
+        if (node_constrained(g, k.faces, ix, iy, iz))
+          for (int a = 0; a < 3; ++a) y[a * N + g.node(ix, iy, iz)] = x[a * N + g.node(ix, iy, iz)];
+}
+
+void elasticity_diagonal(const ElasticityStencil& k, real* d) {
+  const GridDims& g = k.g;
+  const index N = g.nodes();
+#pragma omp parallel for collapse(2) schedule(static)
+  for (index iz = 0; iz < g.nz(); ++iz)
+    for (index iy = 0; iy < g.ny(); ++iy)
+      for (index ix = 0; ix < g.nx(); ++ix) {
+        const std::uint8_t cx = k.cls[0][ix], cy = k.cls[1][iy], cz = k.cls[2][iz];
+        const index n = g.node(ix, iy, iz);
+        const bool fixed = (cx | cy | cz) & kSelf;
+        const std::int32_t s = fixed ? -1 : k.slot[(cx * 32 + cy) * 32 + cz];
+        for (int a = 0; a < 3; ++a) d[a * N + n] = fixed ? 1 : k.center[3 * s + a];
+      }
+}
+
+void elasticity_diagonal_ref(const ElasticityStencil& k, real* d) {
+  const GridDims& g = k.g;
+  const index N = g.nodes();
+  for (index i = 0; i < 3 * N; ++i) d[i] = 0;
+  for (index ez = 0; ez < g.ez; ++ez)
+    for (index ey = 0; ey < g.ey; ++ey)
+      for (index ex = 0; ex < g.ex; ++ex)
+        for (int L = 0; L < 8; ++L) {
+          const index n = g.node(ex + (L & 1), ey + ((L >> 1) & 1), ez + ((L >> 2) & 1));
+          for (int a = 0; a < 3; ++a) d[a * N + n] += k.Ke[24 * (3 * L + a) + 3 * L + a];
+        }
+  for (index iz = 0; iz < g.nz(); ++iz)
+    for (index iy = 0; iy < g.ny(); ++iy)
+      for (index ix = 0; ix < g.nx(); ++ix)
+        if (node_constrained(g, k.faces, ix, iy, iz))
+          for (int a = 0; a < 3; ++a) d[a * N + g.node(ix, iy, iz)] = 1;
+}
+
+void zero_constrained(const GridDims& g, unsigned faces, real* v) {
+  const index N = g.nodes();
+#pragma omp parallel for collapse(2) schedule(static)
+  for (index iz = 0; iz < g.nz(); ++iz)
+    for (index iy = 0; iy < g.ny(); ++iy)
+      for (index ix = 0; ix < g.nx(); ++ix)
+        if (node_constrained(g, faces, ix, iy, iz))
+          for (int a = 0; a < 3; ++a) v[a * N + g.node(ix, iy, iz)] = 0;
+}
+
+}  // namespace tresca

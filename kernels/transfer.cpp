@@ -1,0 +1,139 @@
+#include "transfer.hpp"
+
+namespace tresca {
+namespace {
+
+Interp1D build_axis(index ef, index ec) {
+  Interp1D a;
+  const index nf = ef + 1, nc = ec + 1;
+  a.j0.resize(nf);
+  a.w.resize(nf);
+  for (index i = 0; i < nf; ++i) {
+    // coarse coordinate of fine node i is t = i*ec/ef, computed exactly in integers
+    index j = (i * ec) / ef;
+    index rem = i * ec - j * ef;
+    if (j >= ec) {  // the last node sits on the last coarse node
+      j = ec - 1;
+      rem = ef;
+    }
+    a.j0[i] = j;
+    a.w[i] = real(rem) / real(ef);
+  }
+  std::vector<std::vector<std::pair<index, real>>> lists(nc);
+  for (index i = 0; i < nf; ++i) {
+    if (1 - a.w[i] != 0) lists[a.j0[i]].push_back({i, 1 - a.w[i]});
+    if (a.w[i] != 0) lists[a.j0[i] + 1].push_back({i, a.w[i]});
+  }
+  a.tstart.push_back(0);
+  for (index j = 0; j < nc; ++j) {
+    for (auto& p : lists[j]) {
+      a.tf.push_back(p.first);
+      a.tw.push_back(p.second);
+    }
+    a.tstart.push_back(index(a.tf.size()));
+  }
+  return a;
+}
+
+}  // namespace
+
+Transfer build_transfer(const GridDims& fine, const GridDims& coarse) {
+  Transfer t;
+  t.fine = fine;
+  t.coarse = coarse;
+  t.axis[0] = build_axis(fine.ex, coarse.ex);
+  t.axis[1] = build_axis(fine.ey, coarse.ey);
+  t.axis[2] = build_axis(fine.ez, coarse.ez);
+  return t;
+}
+
+void prolongate(const Transfer& t, int comps, const real* coarse, real* fine) {
+  const GridDims &f = t.fine, &c = t.coarse;
+  const index Nf = f.nodes(), Nc = c.nodes();
+  const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
+#pragma omp parallel for collapse(2) schedule(static)
+  for (index iz = 0; iz < f.nz(); ++iz)
+    for (index iy = 0; iy < f.ny(); ++iy) {
+      const index jz = Z.j0[iz], jy = Y.j0[iy];
+      const real wz = Z.w[iz], wy = Y.w[iy];
+      const real w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
+      const index cnx = c.nx(), cny = c.ny();
+      const index b00 = cnx * (jy + cny * jz), b10 = b00 + cnx, b01 = b00 + cnx * cny, b11 = b01 + cnx;
+      for (int a = 0; a < comps; ++a) {
+        const real* u = coarse + a * Nc;
+        real* v = fine + a * Nf + f.nx() * (iy + f.ny() * iz);
+        for (index ix = 0; ix < f.nx(); ++ix) {
+          const index j = X.j0[ix];
+          const real wx = X.w[ix];
+          const real s0 = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
+          const real s1 =
+              w00 * u[b00 + j + 1] + w10 * u[b10 + j + 1] + w01 * u[b01 + j + 1] + w11 * u[b11 + j + 1];
+          v[ix] = (1 - wx) * s0 + wx * s1;
+        }
+      }
+    }
+}
+
+void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine) {
+  const GridDims &f = t.fine, &c = t.coarse;
+  for (int a = 0; a < comps; ++a)
+    for (index iz = 0; iz < f.nz(); ++iz)
+      for (index iy = 0; iy < f.ny(); ++iy)
+        for (index ix = 0; ix < f.nx(); ++ix) {
+          real s = 0;
+          for (int k = 0; k < 8; ++k) {
+            const int bx = k & 1, by = (k >> 1) & 1, bz = (k >> 2) & 1;
+            const real w = (bx ? t.axis[0].w[ix] : 1 - t.axis[0].w[ix]) *
+                           (by ? t.axis[1].w[iy] : 1 - t.axis[1].w[iy]) *
+                           (bz ? t.axis[2].w[iz] : 1 - t.axis[2].w[iz]);
+            s += w * coarse[a * c.nodes() +
+                            c.node(t.axis[0].j0[ix] + bx, t.axis[1].j0[iy] + by, t.axis[2].j0[iz] + bz)];
+          }
+          fine[a * f.nodes() + f.node(ix, iy, iz)] = s;
+        }
+}
+
+void restrict_to_coarse(const Transfer& t, int comps, const real* fine, real* coarse) {
+  const GridDims &f = t.fine, &c = t.coarse;
+  const index Nf = f.nodes(), Nc = c.nodes();
+  const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
+#pragma omp parallel for collapse(2) schedule(static)
+  for (index jz = 0; jz < c.nz(); ++jz)
+    for (index jy = 0; jy < c.ny(); ++jy)
+      for (int a = 0; a < comps; ++a) {
+        const real* r = fine + a * Nf;
+        real* out = coarse + a * Nc + c.nx() * (jy + c.ny() * jz);
+        for (index jx = 0; jx < c.nx(); ++jx) {
+          real s = 0;
+          for (index kz = Z.tstart[jz]; kz < Z.tstart[jz + 1]; ++kz)
+            for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky) {
+              const real wyz = Z.tw[kz] * Y.tw[ky];
+              const real* rr = r + f.nx() * (Y.tf[ky] + f.ny() * Z.tf[kz]);
+              real sx = 0;
+              for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += X.tw[kx] * rr[X.tf[kx]];
+              s += wyz * sx;
+            }
+          out[jx] = s;
+        }
+      }
+}
+
+void restrict_to_coarse_ref(const Transfer& t, int comps, const real* fine, real* coarse) {
+  const GridDims &f = t.fine, &c = t.coarse;
+  for (index i = 0; i < comps * c.nodes(); ++i) coarse[i] = 0;
+  for (int a = 0; a < comps; ++a)
+    for (index iz = 0; iz < f.nz(); ++iz)
+      for (index iy = 0; iy < f.ny(); ++iy)
+        for (index ix = 0; ix < f.nx(); ++ix)
+          for (int k = 0; k < 8; ++k) {
+            const int bx = k & 1, by = (k >> 1) & 1, bz = (k >> 2) & 1;
+            const real w = (bx ? t.axis[0].w[ix] : 1 - t.axis[0].w[ix]) *
+                           (by ? t.axis[1].w[iy] : 1 - t.axis[1].w[iy]) *
+                           (bz ? t.axis[2].w[iz] : 1 - t.axis[2].w[iz]);
+            coarse[a * c.nodes() +
+                   c.node(t.axis[0].j0[ix] + bx, t.axis[1].j0[iy] + by, t.axis[2].j0[iz] + bz)] +=
+                w * fine[a * f.nodes() + f.node(ix, iy, iz)];
+          }
+}
+
+}  // namespace tresca

@@ -1,0 +1,48 @@
+// Grid transfers between two uniform grids of the same box (non-nested in
+// general: coarse e = ceil(fine e / 2) per axis).
+//
+//   prolongate:  u_f(x_i) = sum_J w_J(x_i) u_c(X_J)   (trilinear interpolation)
+//   restrict:    r_c = P^T r_f                          (exact transpose)
+//
+// P is a tensor product P = Pz ⊗ Py ⊗ Px of 1D interpolations, each row with
+// at most two nonzeros. The optimised kernels are gathers (race-free, OpenMP
+// over output rows): prolongation reads 8 coarse values per fine node,
+// restriction reads the fine nodes in the support of each coarse hat function
+// (1D transposed lists). The _ref twins are the literal serial loops
+// (restriction as a scatter of P^T).
+//
+// DATA LAYOUT: SoA fields as in grid.hpp; `comps` components of size N each.
+// Cost per fine dof: prolongation 8 reads + 1 write; restriction about the same
+// in total over the coarse dofs.
+#pragma once
+#include <vector>
+
+#include "grid.hpp"
+#include "types.hpp"
+
+namespace tresca {
+
+struct Interp1D {
+  // fine node i interpolates from coarse j0[i] (weight 1-w[i]) and j0[i]+1 (weight w[i])
+  std::vector<index> j0;
+  std::vector<real> w;
+  // transpose lists: coarse j receives from fine tf[tstart[j]..tstart[j+1]) with weights tw
+  std::vector<index> tstart, tf;
+  std::vector<real> tw;
+};
+
+struct Transfer {
+  GridDims fine, coarse;
+  Interp1D axis[3];
+};
+
+Transfer build_transfer(const GridDims& fine, const GridDims& coarse);
+
+// fine = P coarse, for `comps` components
+void prolongate(const Transfer& t, int comps, const real* coarse, real* fine);
+void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine);
+// coarse = P^T fine
+void restrict_to_coarse(const Transfer& t, int comps, const real* fine, real* coarse);
+void restrict_to_coarse_ref(const Transfer& t, int comps, const real* fine, real* coarse);
+
+}  // namespace tresca

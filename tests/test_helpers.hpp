@@ -1,0 +1,36 @@
+// Small helpers shared by the tests: deterministic random vectors and norms.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "kernels/types.hpp"
+
+namespace tresca::test {
+
+inline std::vector<real> random_vector(index n, std::uint64_t seed = 1) {
+  std::vector<real> v(n);
+  std::uint64_t s = seed * 0x9E3779B97F4A7C15ULL + 7;
+  for (auto& x : v) {
+    s ^= s << 13;
+    s ^= s >> 7;
+    s ^= s << 17;
+    x = real(s >> 11) / real(1ULL << 53) * 2 - 1;
+  }
+  return v;
+}
+
+inline real max_abs(const std::vector<real>& v) {
+  real m = 0;
+  for (real x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
+inline real max_abs_diff(const std::vector<real>& a, const std::vector<real>& b) {
+  real m = 0;
+  for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
+  return m;
+}
+
+}  // namespace tresca::test
