@@ -43,6 +43,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
     return st;
   }
   if (st.residual <= target) return st;
+  if (opt.on_residual) opt.on_residual(st.residual);
   auto precondition = [&] {
     if (M)
       M->apply(r, z);
@@ -64,6 +65,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
       return st;
     }
     const real alpha = rz / pq;
+    if (opt.on_step) opt.on_step(alpha);
     rr = cg_update(n, alpha, p, q, x, r);
     st.iterations = it;
     st.residual = std::sqrt(rr);
@@ -72,6 +74,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
       return st;
     }
     if (st.residual <= target) return st;
+    if (opt.on_residual) opt.on_residual(st.residual);
     precondition();
     const real rz_new = dot(n, r, z);
     xpay(n, z, rz_new / rz, p);

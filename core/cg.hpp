@@ -8,6 +8,7 @@
 // Per iteration: 1 apply of A, 1 of M, 2 dots + 1 fused update + 1 xpay:
 // vector traffic about 112 bytes and 14 flops per entry besides A and M.
 #pragma once
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,12 @@ struct CGOptions {
   real atol = 0;
   int max_iterations = 1000;
   bool zero_initial_guess = true;  // otherwise x holds the initial guess
+  // called after each step x += alpha p, right after A was applied to p (lets
+  // a caller accumulate side products of that apply, e.g. S x += alpha S p)
+  std::function<void(real alpha)> on_step;
+  // called with ||r|| of the initial residual and after every update (lets an
+  // inexactly applied A relax its accuracy as the residual falls)
+  std::function<void(real rnorm)> on_residual;
 };
 
 // Work vectors kept by the caller so repeated solves do not allocate.

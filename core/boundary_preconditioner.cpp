@@ -1,0 +1,52 @@
+#include "boundary_preconditioner.hpp"
+
+#include "../kernels/vector_ops.hpp"
+
+namespace tresca {
+
+namespace {
+// penalty on fixed dofs relative to the diagonal of K: large enough that the
+// fixed dofs decouple, small enough that Jacobi smoothing stays well scaled
+constexpr real kPenalty = 1e4;
+}  // namespace
+
+BoundaryPreconditioner::BoundaryPreconditioner(const SteklovPoincare& S, const MGOptions& mg)
+    : S_(S), mg_(S.problem().grid, S.problem().dirichlet_faces, S.problem().spec.E, S.problem().spec.nu, mg) {
+  const GridDims& g = S.problem().grid;
+  const index M = g.nx() * g.ny(), N = g.nodes();
+  const std::vector<real> d = mg_.op(0).diagonal();
+  kdiag_bottom_.resize(3 * M);
+  for (int a = 0; a < 3; ++a)
+    for (index n = 0; n < M; ++n) kdiag_bottom_[a * M + n] = d[a * N + n];
+  full_in_.assign(3 * N, 0);
+  full_out_.assign(3 * N, 0);
+}
+
+void BoundaryPreconditioner::update(const std::vector<real>& h, const std::vector<std::uint8_t>& fixed,
+                                    const std::vector<std::uint8_t>& free_mask) {
+  const Problem& P = S_.problem();
+  const GridDims& g = P.grid;
+  const index M = g.nx() * g.ny(), p = P.contact_nodes();
+  std::vector<real> B(4 * M, 0.0);
+  for (index c = 0; c < p; ++c) {
+    const index n = P.contact_grid_node(c);  // bottom plane: grid node index = plane index
+    B[0 * M + n] = fixed[c] ? kPenalty * kdiag_bottom_[n] : h[c];
+    B[1 * M + n] = (fixed[c] || fixed[p + c]) ? 0 : h[p + c];
+    B[2 * M + n] = fixed[p + c] ? kPenalty * kdiag_bottom_[M + n] : h[2 * p + c];
+    B[3 * M + n] = fixed[2 * p + c] ? kPenalty * kdiag_bottom_[2 * M + n] : 0;
+  }
+  mg_.set_bottom_block(B);
+  free_ = free_mask;
+}
+
+void BoundaryPreconditioner::apply(const real* r, real* z) const {
+  const index n = index(full_in_.size());
+  fill(n, 0, full_in_.data());
+  S_.scatter(r, full_in_.data());
+  mg_.apply(full_in_.data(), full_out_.data());
+  S_.gather(full_out_.data(), z);
+  for (index i = 0; i < size(); ++i)
+    if (!free_[i]) z[i] = 0;
+}
+
+}  // namespace tresca

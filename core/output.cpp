@@ -1,0 +1,204 @@
+#include "output.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+
+#include "../kernels/contact_maps.hpp"
+
+namespace tresca {
+
+namespace {
+using FilePtr = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
+
+FilePtr open_tmp(const std::string& path) {
+  std::FILE* f = std::fopen((path + ".tmp").c_str(), "wb");
+  if (!f) throw std::runtime_error("cannot write '" + path + "'");
+  return FilePtr(f, &std::fclose);
+}
+
+void commit(FilePtr f, const std::string& path) {
+  const bool ok = !std::ferror(f.get());
+  if (std::fclose(f.release()) != 0 || !ok) {
+    std::remove((path + ".tmp").c_str());
+    throw std::runtime_error("error while writing '" + path + "'");
+  }
+  if (std::rename((path + ".tmp").c_str(), path.c_str()) != 0) {
+    std::remove((path + ".tmp").c_str());
+    throw std::runtime_error("cannot rename '" + path + ".tmp' to '" + path + "'");
+  }
+}
+
+std::string stem_of(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  const auto dot = path.find_last_of('.');
+  return (dot != std::string::npos && (slash == std::string::npos || dot > slash)) ? path.substr(0, dot) : path;
+}
+
+int status_code(std::uint8_t s) { return (s & kContact) ? ((s & kStick) ? 2 : 3) : 1; }
+}  // namespace
+
+void check_writable(const std::string& path) {
+  std::FILE* f = std::fopen((path + ".tmp").c_str(), "wb");
+  if (!f) throw std::invalid_argument("cannot write output file '" + path + "'");
+  std::fclose(f);
+  std::remove((path + ".tmp").c_str());
+}
+
+void write_file_atomic(const std::string& path, const std::string& contents) {
+  FilePtr f = open_tmp(path);
+  std::fwrite(contents.data(), 1, contents.size(), f.get());
+  commit(std::move(f), path);
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+Json& Json::num(const std::string& k, double v) {
+  items_.push_back({k, json_number(v)});
+  return *this;
+}
+Json& Json::integer(const std::string& k, long long v) {
+  items_.push_back({k, std::to_string(v)});
+  return *this;
+}
+Json& Json::boolean(const std::string& k, bool v) {
+  items_.push_back({k, v ? "true" : "false"});
+  return *this;
+}
+Json& Json::str(const std::string& k, const std::string& v) {
+  std::string e = "\"";
+  for (char c : v) {
+    if (c == '"' || c == '\\') e += '\\';
+    e += c;
+  }
+  items_.push_back({k, e + "\""});
+  return *this;
+}
+Json& Json::null(const std::string& k) {
+  items_.push_back({k, "null"});
+  return *this;
+}
+Json& Json::array(const std::string& k, const std::vector<double>& v) {
+  std::string s = "[";
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + json_number(v[i]);
+  items_.push_back({k, s + "]"});
+  return *this;
+}
+Json& Json::raw(const std::string& k, const std::string& json) {
+  items_.push_back({k, json});
+  return *this;
+}
+std::string Json::render() const {
+  std::string s = "{";
+  for (size_t i = 0; i < items_.size(); ++i) s += (i ? ", " : "") + ("\"" + items_[i].first + "\": ") + items_[i].second;
+  return s + "}";
+}
+
+void write_contact_csv(const std::string& path, const Problem& P, const ContactFields& c) {
+  FilePtr f = open_tmp(path);
+  const index p = P.contact_nodes();
+  const GridDims& g = P.grid;
+  std::fprintf(f.get(), "ix,iy,x,y,ux,uy,uz,lambda,contact,stick\n");
+  for (index i = 0; i < p; ++i) {
+    const index ix = 1 + i % g.ex, iy = i / g.ex;
+    const std::uint8_t s = (*c.status)[i];
+    std::fprintf(f.get(), "%lld,%lld,%.10g,%.10g,%.17g,%.17g,%.17g,%.17g,%d,%d\n", (long long)ix, (long long)iy,
+                 g.x0 + ix * g.hx(), g.y0 + iy * g.hy(), (*c.u)[i], (*c.u)[p + i], (*c.u)[2 * p + i],
+                 (*c.lambda)[i], (s & kContact) ? 1 : 0, (s & kStick) ? 1 : 0);
+  }
+  commit(std::move(f), path);
+}
+
+namespace {
+void vtu_header(std::FILE* f, index points, index cells) {
+  std::fprintf(f,
+               "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+               "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"%lld\" "
+               "NumberOfCells=\"%lld\">\n",
+               (long long)points, (long long)cells);
+}
+void vtu_cells(std::FILE* f, const std::vector<index>& conn, int per_cell, int vtk_type) {
+  const index cells = index(conn.size()) / per_cell;
+  std::fprintf(f, "<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
+  for (index i = 0; i < index(conn.size()); ++i) std::fprintf(f, "%lld%c", (long long)conn[i], (i + 1) % per_cell ? ' ' : '\n');
+  std::fprintf(f, "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+  for (index c = 0; c < cells; ++c) std::fprintf(f, "%lld\n", (long long)(per_cell * (c + 1)));
+  std::fprintf(f, "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
+  for (index c = 0; c < cells; ++c) std::fprintf(f, "%d\n", vtk_type);
+  std::fprintf(f, "</DataArray>\n</Cells>\n");
+}
+}  // namespace
+
+std::string write_vtu(const std::string& path, const Problem& P, const std::vector<real>& u_full,
+                      const ContactFields& c) {
+  const GridDims& g = P.grid;
+  const index N = g.nodes(), p = P.contact_nodes(), M = g.nx() * g.ny();
+  // per grid node: contact node id or -1
+  std::vector<index> cid(M, -1);
+  for (index i = 0; i < p; ++i) cid[P.contact_grid_node(i)] = i;
+  {
+    FilePtr f = open_tmp(path);
+    vtu_header(f.get(), N, g.ex * g.ey * g.ez);
+    std::fprintf(f.get(), "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for (index iz = 0; iz < g.nz(); ++iz)
+      for (index iy = 0; iy < g.ny(); ++iy)
+        for (index ix = 0; ix < g.nx(); ++ix)
+          std::fprintf(f.get(), "%.9g %.9g %.9g\n", g.x0 + ix * g.hx(), g.y0 + iy * g.hy(), g.z0 + iz * g.hz());
+    std::fprintf(f.get(), "</DataArray>\n</Points>\n");
+    std::vector<index> conn;
+    conn.reserve(size_t(8 * g.ex * g.ey * g.ez));
+    const int order[8] = {0, 1, 3, 2, 4, 5, 7, 6};  // VTK_HEXAHEDRON node order
+    for (index ez = 0; ez < g.ez; ++ez)
+      for (index ey = 0; ey < g.ey; ++ey)
+        for (index ex = 0; ex < g.ex; ++ex)
+          for (int k : order) conn.push_back(g.node(ex + (k & 1), ey + ((k >> 1) & 1), ez + ((k >> 2) & 1)));
+    vtu_cells(f.get(), conn, 8, 12);
+    std::fprintf(f.get(), "<PointData Vectors=\"displacement\">\n");
+    std::fprintf(f.get(), "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for (index n = 0; n < N; ++n) std::fprintf(f.get(), "%.12g %.12g %.12g\n", u_full[n], u_full[N + n], u_full[2 * N + n]);
+    std::fprintf(f.get(), "</DataArray>\n<DataArray type=\"Float64\" Name=\"contact_force\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for (index n = 0; n < N; ++n) {
+      const index i = n < M ? cid[n] : -1;
+      if (i < 0)
+        std::fprintf(f.get(), "0 0 0\n");
+      else
+        std::fprintf(f.get(), "%.12g %.12g %.12g\n", (*c.r)[i], (*c.r)[p + i], (*c.lambda)[i]);
+    }
+    std::fprintf(f.get(), "</DataArray>\n<DataArray type=\"UInt8\" Name=\"contact_status\" format=\"ascii\">\n");
+    for (index n = 0; n < N; ++n) {
+      const index i = n < M ? cid[n] : -1;
+      std::fprintf(f.get(), "%d\n", i < 0 ? 0 : status_code((*c.status)[i]));
+    }
+    std::fprintf(f.get(), "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    commit(std::move(f), path);
+  }
+  // contact face: the bottom plane as quads, its own point numbering
+  const std::string cpath = stem_of(path) + "_contact.vtu";
+  FilePtr f = open_tmp(cpath);
+  vtu_header(f.get(), M, g.ex * g.ey);
+  std::fprintf(f.get(), "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+  for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%.9g %.9g %.9g\n", g.x0 + (n % g.nx()) * g.hx(), g.y0 + (n / g.nx()) * g.hy(), g.z0);
+  std::fprintf(f.get(), "</DataArray>\n</Points>\n");
+  std::vector<index> conn;
+  for (index ey = 0; ey < g.ey; ++ey)
+    for (index ex = 0; ex < g.ex; ++ex)
+      for (index k : {index(0), index(1), g.nx() + 1, g.nx()}) conn.push_back(ex + g.nx() * ey + k);
+  vtu_cells(f.get(), conn, 4, 9);
+  std::fprintf(f.get(), "<PointData Vectors=\"displacement\">\n<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+  for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%.12g %.12g %.12g\n", u_full[n], u_full[N + n], u_full[2 * N + n]);
+  std::fprintf(f.get(), "</DataArray>\n<DataArray type=\"Float64\" Name=\"lambda\" format=\"ascii\">\n");
+  for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%.12g\n", cid[n] < 0 ? 0.0 : (*c.lambda)[cid[n]]);
+  std::fprintf(f.get(), "</DataArray>\n<DataArray type=\"UInt8\" Name=\"contact_status\" format=\"ascii\">\n");
+  for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%d\n", cid[n] < 0 ? 0 : status_code((*c.status)[cid[n]]));
+  std::fprintf(f.get(), "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+  commit(std::move(f), cpath);
+  return cpath;
+}
+
+}  // namespace tresca

@@ -1,0 +1,49 @@
+// Output writers. Every file is written completely or not at all: data go to
+// "<path>.tmp" first, which is renamed over <path> only after a successful
+// close. Failures throw std::runtime_error naming the path.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "problem.hpp"
+
+namespace tresca {
+
+// Throws if `path` cannot be created (checked before a long run starts).
+void check_writable(const std::string& path);
+void write_file_atomic(const std::string& path, const std::string& contents);
+
+// Tiny JSON object builder (keys in insertion order).
+class Json {
+ public:
+  Json& num(const std::string& k, double v);
+  Json& integer(const std::string& k, long long v);
+  Json& boolean(const std::string& k, bool v);
+  Json& str(const std::string& k, const std::string& v);
+  Json& null(const std::string& k);
+  Json& array(const std::string& k, const std::vector<double>& v);
+  Json& raw(const std::string& k, const std::string& json);  // pre-rendered value
+  std::string render() const;
+
+ private:
+  std::vector<std::pair<std::string, std::string>> items_;
+};
+std::string json_number(double v);
+
+struct ContactFields {
+  const std::vector<real>* u;       // 3p
+  const std::vector<real>* lambda;  // p
+  const std::vector<real>* r;       // 3p contact forces (r_τ, r_z)
+  const std::vector<std::uint8_t>* status;
+};
+
+void write_contact_csv(const std::string& path, const Problem& P, const ContactFields& c);
+// Body as VTK XML unstructured grid (hexahedra) with point data displacement,
+// contact_force and contact_status (0 not a contact node, 1 separated,
+// 2 contact+stick, 3 contact+slip); the contact face (quads) goes to
+// "<stem>_contact.vtu" next to it. Returns the second file's path.
+std::string write_vtu(const std::string& path, const Problem& P, const std::vector<real>& u_full,
+                      const ContactFields& c);
+
+}  // namespace tresca

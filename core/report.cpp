@@ -1,0 +1,55 @@
+#include "report.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "../kernels/contact_maps.hpp"
+#include "../kernels/vector_ops.hpp"
+
+namespace tresca {
+
+FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, real phi,
+                         const NewtonResult& R, real tight_rtol) {
+  const index p = S.size() / 3;
+  FinalReport F;
+  const real keep = S.inner_rtol();
+  S.set_inner_rtol(tight_rtol);
+  std::vector<real> Su(3 * p), v(4 * p), d(3 * p);
+  S.apply(R.u.data(), Su.data());
+  S.set_inner_rtol(keep);
+  F.r.resize(3 * p);
+  for (index i = 0; i < 3 * p; ++i) F.r[i] = Su[i] - btilde[i];
+  F.status.resize(p);
+  F.true_residual = std::sqrt(approximation_step(p, phi, R.u.data(), R.lambda.data(), F.r.data(), v.data(),
+                                                 d.data(), F.status.data()));
+  F.btilde_norm = norm2(3 * p, btilde.data());
+  F.true_residual_relative = F.btilde_norm > 0 ? F.true_residual / F.btilde_norm : F.true_residual;
+  F.ux_min = INFINITY;
+  F.uz_max = -INFINITY;
+  for (index i = 0; i < p; ++i) {
+    const real ux = R.u[i], uy = R.u[p + i], uz = R.u[2 * p + i], lam = R.lambda[i];
+    const real rx = F.r[i], ry = F.r[p + i], rz = F.r[2 * p + i];
+    F.equilibrium = std::max(F.equilibrium, std::abs(rz - lam));
+    F.uz_violation = std::max(F.uz_violation, -uz);
+    F.lambda_violation = std::max(F.lambda_violation, -lam);
+    F.complementarity = std::max(F.complementarity, std::abs(lam * uz));
+    const real rt = std::hypot(rx, ry), ut = std::hypot(ux, uy);
+    F.friction_bound = std::max(F.friction_bound, rt - phi);
+    const bool stick = F.status[i] & kStick;
+    if (stick) {
+      F.stick_slip = std::max(F.stick_slip, ut);
+      F.sticking += 1;
+    } else {
+      F.sliding += 1;
+      if (ut > 0) F.friction_direction = std::max(F.friction_direction, std::hypot(rx + phi * ux / ut, ry + phi * uy / ut));
+    }
+    (F.status[i] & kContact ? F.active : F.separated) += 1;
+    F.ux_min = std::min(F.ux_min, ux);
+    F.uz_max = std::max(F.uz_max, uz);
+    F.lambda_sum += lam;
+  }
+  F.friction_bound = std::max(F.friction_bound, real(0));
+  return F;
+}
+
+}  // namespace tresca

@@ -1,0 +1,25 @@
+#include "run.hpp"
+
+#include "profile.hpp"
+
+namespace tresca {
+
+RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
+  RunResult R;
+  const double t0 = wall_time();
+  R.problem = std::make_unique<Problem>(make_problem(spec));
+  SteklovPoincare S(*R.problem);
+  const double t1 = wall_time();
+  const std::vector<real> btilde = S.condensed_load(opt.tight_rtol);
+  const double t2 = wall_time();
+  R.newton = semismooth_newton(S, btilde, spec.phi, opt.newton);
+  const double t3 = wall_time();
+  R.report = final_report(S, btilde, spec.phi, R.newton, opt.tight_rtol);
+  if (opt.recover_interior) R.u_full = S.recover(R.newton.u.data(), opt.tight_rtol);
+  const double t4 = wall_time();
+  R.times = {t1 - t0, t2 - t1, t3 - t2, t4 - t3, t4 - t0};
+  R.inner_iterations = S.stats().iterations;
+  return R;
+}
+
+}  // namespace tresca

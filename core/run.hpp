@@ -1,0 +1,35 @@
+// One complete solve of the contact problem, with the timings of the paper's
+// Table 1 columns: setup (mesh, operators, multigrid hierarchy), condense
+// (b̃ = condensed load), solve (semismooth* Newton), recover (final check
+// with a tight S apply + interior displacement).
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "report.hpp"
+#include "semismooth.hpp"
+
+namespace tresca {
+
+struct RunOptions {
+  NewtonOptions newton;
+  bool recover_interior = true;  // full 3D displacement (needed for VTK output)
+  real tight_rtol = 1e-12;
+};
+
+struct RunTimes {
+  double setup = 0, condense = 0, solve = 0, recover = 0, total = 0;
+};
+
+struct RunResult {
+  std::unique_ptr<Problem> problem;
+  RunTimes times;
+  NewtonResult newton;
+  FinalReport report;
+  std::vector<real> u_full;  // 3N SoA (empty if not recovered)
+  long long inner_iterations = 0;  // over the whole run, including condensation and recovery
+};
+
+RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt);
+
+}  // namespace tresca

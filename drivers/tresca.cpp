@@ -1,0 +1,218 @@
+// tresca: 3D linear-elastic contact with Tresca friction by the semismooth*
+// Newton method, matrix-free on the contact boundary. See --help.
+// Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure.
+#include <cstdio>
+#include <exception>
+#include <stdexcept>
+#include <string>
+
+#include "core/cli.hpp"
+#include "core/output.hpp"
+#include "core/profile.hpp"
+#include "core/run.hpp"
+
+using namespace tresca;
+
+namespace {
+
+const char* kHelp =
+    "usage: tresca [options]\n"
+    "  --level L          mesh level (default 6): ex = ceil(4*2^(L/2)), ey = ez = ceil(2*2^(L/2))\n"
+    "  --dims EXxEYxEZ    explicit element counts instead of a level\n"
+    "  --phi F            Tresca friction bound per contact node [N] (default 1)\n"
+    "  --eps E            stopping tolerance on ||v|| (default 1e-6, absolute)\n"
+    "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
+    "  --max-newton N     Newton iteration limit (default 50)\n"
+    "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
+    "  --json FILE        write the run summary as one JSON object (rows with --table)\n"
+    "  --contact-csv FILE one row per contact node\n"
+    "  --vtk FILE.vtu     deformed body for ParaView (+ FILE_contact.vtu)\n"
+    "  --table A-B        solve levels A..B and print the paper's Table 1 columns\n"
+    "  --profile          per-kernel time, GB/s and GFLOP/s after the run\n"
+    "  --quiet            no progress lines\n"
+    "  --help             this text\n"
+    "Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure.\n";
+
+// The paper's Table 1 (MATLAB): level, n, assembly [s], Cholesky & Schur [s], p, solver [s], iterations
+struct PaperRow {
+  int level;
+  long long n;
+  double assembly, schur;
+  long long p;
+  double solver;
+  int iters;
+};
+const PaperRow kPaper[] = {{1, 225, 0.078, 0.003, 40, 0.017, 5},        {2, 225, 0.031, 0.003, 40, 0.017, 6},
+                           {3, 637, 0.094, 0.021, 84, 0.047, 6},        {4, 1377, 0.141, 0.092, 144, 0.101, 6},
+                           {5, 4056, 0.516, 0.701, 299, 0.507, 7},      {6, 9537, 1.297, 3.968, 544, 1.928, 7},
+                           {7, 27072, 3.156, 32.110, 1104, 9.734, 7},   {8, 70785, 18.672, 1242.211, 2112, 48.275, 8}};
+const PaperRow* paper_row(int level) {
+  for (const auto& r : kPaper)
+    if (r.level == level) return &r;
+  return nullptr;
+}
+
+std::string summary_json(const ProblemSpec& spec, const RunResult& R, int threads) {
+  const Problem& P = *R.problem;
+  const FinalReport& F = R.report;
+  const NewtonResult& N = R.newton;
+  Json times, counts, contact, kkt;
+  times.num("setup", R.times.setup).num("condense", R.times.condense).num("solve", R.times.solve)
+      .num("recover", R.times.recover).num("total", R.times.total);
+  counts.integer("inner_iterations", R.inner_iterations).integer("outer_iterations", N.outer_iterations)
+      .integer("operator_applications", N.operator_applications)
+      .integer("newton_inner_iterations", N.inner_iterations);
+  contact.integer("active", F.active).integer("separated", F.separated).integer("sticking", F.sticking)
+      .integer("sliding", F.sliding).num("ux_min", F.ux_min).num("uz_max", F.uz_max).num("lambda_sum", F.lambda_sum);
+  kkt.num("equilibrium", F.equilibrium).num("uz_violation", F.uz_violation).num("lambda_violation", F.lambda_violation)
+      .num("complementarity", F.complementarity).num("friction_bound", F.friction_bound)
+      .num("friction_direction", F.friction_direction).num("stick_slip", F.stick_slip);
+  Json j;
+  if (spec.level >= 0)
+    j.integer("level", spec.level);
+  else
+    j.null("level");
+  j.raw("dims", "[" + std::to_string(spec.ex) + ", " + std::to_string(spec.ey) + ", " + std::to_string(spec.ez) + "]")
+      .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
+      .num("phi", spec.phi).num("eps", 0).integer("threads", threads).integer("newton_iterations", N.iterations)
+      .boolean("converged", N.converged()).str("reason", to_string(N.reason))
+      .array("residual_history", N.history).num("final_residual", N.history.empty() ? 0 : N.history.back())
+      .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
+      .raw("times", times.render()).raw("counts", counts.render()).raw("contact", contact.render())
+      .raw("kkt", kkt.render());
+  return j.render();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args* args = nullptr;
+  ProblemSpec spec;
+  RunOptions opt;
+  int threads = 1;
+  std::string json_path, csv_path, vtk_path, table;
+  bool quiet = false, profile = false;
+  try {
+    static Args a(argc, argv,
+                  {"--level", "--dims", "--phi", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
+                   "--contact-csv", "--vtk", "--table"},
+                  {"--quiet", "--help", "--profile"});
+    args = &a;
+    if (a.has("--help")) {
+      std::fputs(kHelp, stdout);
+      return 0;
+    }
+    threads = apply_threads(a);
+    table = a.str("--table");
+    if (!table.empty() && (a.has("--level") || a.has("--dims") || a.has("--vtk") || a.has("--contact-csv")))
+      throw std::invalid_argument("--table runs its own levels; it takes no --level/--dims/--vtk/--contact-csv");
+    spec = spec_from_args(a, 6);
+    opt.newton.eps = a.real_value("--eps", 1e-6);
+    if (!(opt.newton.eps > 0)) throw std::invalid_argument("--eps " + a.str("--eps") + " must be > 0");
+    const long long mn = a.int_value("--max-newton", 50);
+    if (mn < 0 || mn > 100000) throw std::invalid_argument("--max-newton " + a.str("--max-newton") + " must be in 0..100000");
+    opt.newton.max_iterations = int(mn);
+    quiet = a.has("--quiet");
+    profile = a.has("--profile");
+    json_path = a.str("--json");
+    csv_path = a.str("--contact-csv");
+    vtk_path = a.str("--vtk");
+    for (const std::string* p : {&json_path, &csv_path, &vtk_path})
+      if (a.has(p == &json_path ? "--json" : p == &csv_path ? "--contact-csv" : "--vtk")) {
+        if (p->empty()) throw std::invalid_argument("empty output file name");
+        check_writable(*p);
+      }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tresca: error: %s\n", e.what());
+    return 2;
+  }
+  (void)args;
+
+  try {
+    if (!quiet)
+      opt.newton.progress = [](const NewtonProgress& p) {
+        std::printf("  it %2d  |v| %10.3e  contact %7lld  separated %7lld  stick %7lld  slip %7lld  inner %7lld  outer %5lld  %8.2f s\n",
+                    p.iteration, p.residual, (long long)p.active, (long long)p.separated, (long long)p.sticking,
+                    (long long)p.sliding, p.inner_iterations, p.outer_iterations, p.elapsed);
+        std::fflush(stdout);
+      };
+    if (!table.empty()) {
+      const std::vector<int> levels = parse_level_range(table);
+      for (int L : levels) check_memory(spec_for_level(L));
+      std::printf("%5s %9s %9s %9s %7s %9s %5s %5s | paper: %9s %9s %9s %5s | %s\n", "level", "n", "setup", "condense",
+                  "p", "solve", "iters", "conv", "assembly", "schur", "solver", "iters", "true residual (rel)");
+      std::string rows = "[";
+      bool all = true;
+      for (int L : levels) {
+        ProblemSpec s = spec_for_level(L);
+        s.phi = spec.phi;
+        s.E = spec.E;
+        s.nu = spec.nu;
+        RunOptions o = opt;
+        o.newton.progress = nullptr;
+        o.recover_interior = false;
+        const RunResult R = run_tresca(s, o);
+        const PaperRow* pr = paper_row(L);
+        char pbuf[128] = "        -         -         -     -";
+        if (pr) std::snprintf(pbuf, sizeof pbuf, "%9.3f %9.3f %9.3f %5d", pr->assembly, pr->schur, pr->solver, pr->iters);
+        std::printf("%5d %9lld %9.3f %9.3f %7lld %9.3f %5d %5s | paper: %s | %.2e (%.1e)\n", L,
+                    (long long)R.problem->nodes(), R.times.setup, R.times.condense, (long long)R.problem->contact_nodes(),
+                    R.times.solve, R.newton.iterations, R.newton.converged() ? "yes" : "NO", pbuf,
+                    R.report.true_residual, R.report.true_residual_relative);
+        std::fflush(stdout);
+        all = all && R.newton.converged();
+        rows += (rows.size() > 1 ? ",\n " : "") + summary_json(s, R, threads);
+      }
+      if (!json_path.empty()) write_file_atomic(json_path, rows + "]\n");
+      return all ? 0 : 1;
+    }
+
+    if (!quiet) {
+      const Problem P0 = make_problem(spec);
+      std::printf("tresca: mesh %s (level %s), %lld nodes, %lld contact nodes, %lld dofs, phi %g, eps %g, %d threads\n",
+                  dims_string(spec).c_str(), spec.level >= 0 ? std::to_string(spec.level).c_str() : "-",
+                  (long long)P0.nodes(), (long long)P0.contact_nodes(), (long long)P0.free_dofs(), spec.phi,
+                  opt.newton.eps, threads);
+      std::printf("        estimated peak memory %.2f GB\n", estimated_memory_bytes(spec) / 1e9);
+    }
+    opt.recover_interior = !vtk_path.empty() || profile || true;
+    const RunResult R = run_tresca(spec, opt);
+    const NewtonResult& N = R.newton;
+    const FinalReport& F = R.report;
+    std::printf("%s after %d Newton iterations (reason: %s), final |v| %.3e (eps %.1e)\n",
+                N.converged() ? "converged" : "NOT CONVERGED", N.iterations, to_string(N.reason),
+                N.history.empty() ? 0.0 : N.history.back(), opt.newton.eps);
+    std::printf("true residual (fresh S u): %.3e absolute, %.3e relative to |b| = %.3e\n", F.true_residual,
+                F.true_residual_relative, F.btilde_norm);
+    std::printf("KKT: equilibrium %.2e N, uz<0 %.2e m, lambda<0 %.2e N, lambda*uz %.2e Nm, |r_t|-phi %.2e N, direction %.2e N, stick slip %.2e m\n",
+                F.equilibrium, F.uz_violation, F.lambda_violation, F.complementarity, F.friction_bound,
+                F.friction_direction, F.stick_slip);
+    std::printf("contact: %lld active, %lld separated, %lld sticking, %lld sliding; min ux %.6e, max uz %.6e, sum lambda %.6e\n",
+                (long long)F.active, (long long)F.separated, (long long)F.sticking, (long long)F.sliding, F.ux_min,
+                F.uz_max, F.lambda_sum);
+    std::printf("work: %lld inner CG iterations, %lld outer CG iterations, %lld S applications\n", R.inner_iterations,
+                N.outer_iterations, N.operator_applications);
+    std::printf("times [s]: setup %.3f, condense %.3f, solve %.3f, recover %.3f, total %.3f\n", R.times.setup,
+                R.times.condense, R.times.solve, R.times.recover, R.times.total);
+    if (profile) std::printf("\n%s", profile_table(R.times.total).c_str());
+    try {
+      const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status};
+      if (!json_path.empty()) write_file_atomic(json_path, summary_json(spec, R, threads) + "\n");
+      if (!csv_path.empty()) write_contact_csv(csv_path, *R.problem, cf);
+      if (!vtk_path.empty()) {
+        const std::string second = write_vtu(vtk_path, *R.problem, R.u_full, cf);
+        if (!quiet) std::printf("wrote %s and %s\n", vtk_path.c_str(), second.c_str());
+      }
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "tresca: error: %s\n", e.what());
+      return 3;
+    }
+    return N.converged() ? 0 : 1;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "tresca: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tresca: error: %s\n", e.what());
+    return 1;
+  }
+}

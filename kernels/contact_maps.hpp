@@ -1,0 +1,37 @@
+// Per-contact-node maps of the semismooth* Newton method (method.md §3–4).
+//
+// Unknowns per node i: x = (u_x, u_y, u_z, lambda); r = S u − b̃ (3 blocks of p).
+// F_12 = r_12, F_3 = r_3 − lambda, F_4 = u_z.
+// Approximation step (closed forms of the paper's problems (i)–(iii)):
+//   z = x_12 − F_12,  d_12 = max(0, 1 − phi/|z|) z,  v_12 = d_12 − x_12
+//   v_3 = −F_3
+//   d_4 = max(0, lambda − u_z),                      v_4 = d_4 − lambda
+// Node status: sticking iff d_12 = 0; in contact iff d_4 > 0.
+// Newton blocks (10): sliding H_1 = phi/|d|^3 [[d2², −d1 d2], [−d1 d2, d1²]].
+//
+// DATA LAYOUT: SoA. u, r: [x | y | z] blocks of p; lambda: p; v: 4 blocks of p
+// [v1 | v2 | v3 | v4]; d: 3 blocks [d1 | d2 | d4]; status: p bytes
+// (bit0 contact, bit1 stick). Cost per node: ~30 flops, ~120 bytes.
+#pragma once
+#include <cstdint>
+
+#include "types.hpp"
+
+namespace tresca {
+
+enum : std::uint8_t { kContact = 1, kStick = 2 };
+
+// Writes v, d, status; returns sum of v^2 (deterministic order).
+real approximation_step(index p, real phi, const real* u, const real* lambda, const real* r, real* v, real* d,
+                        std::uint8_t* status);
+
+// The 2x2 block H_1 of a sliding node from d_12 (entries h11, h12, h22).
+inline void sliding_block(real phi, real d1, real d2, real& h11, real& h12, real& h22) {
+  const real n2 = d1 * d1 + d2 * d2;
+  const real c = phi / (n2 * __builtin_sqrt(n2));
+  h11 = c * d2 * d2;
+  h12 = -c * d1 * d2;
+  h22 = c * d1 * d1;
+}
+
+}  // namespace tresca
