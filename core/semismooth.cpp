@@ -60,6 +60,14 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   R.lambda.assign(p, 0);
   R.Su.assign(n3, 0);
   R.status.assign(p, 0);
+  if (opt.u0 && opt.lambda0) {
+    R.u = *opt.u0;
+    R.lambda = *opt.lambda0;
+    const real keep = S.inner_rtol();
+    S.set_inner_rtol(1e-12);
+    S.apply(R.u.data(), R.Su.data());
+    S.set_inner_rtol(keep);
+  }
   std::vector<real> r(n3), v(4 * p), d(3 * p), h(n3), rhs(n3), du(n3), dknown(n3), Sdu(n3);
   std::vector<std::uint8_t> fixed(n3), free(n3);
   BoundaryPreconditioner M(S);

@@ -48,6 +48,10 @@ struct NewtonOptions {
   real step_accuracy = 1e-3;  // late steps are solved to this fraction of ||v̂_k||
   int stagnation_window = 8;  // stop if ||v̂|| has not decreased over this many steps
   std::function<void(const NewtonProgress&)> progress;
+  // optional initial iterate (default x0 = 0): u0 (3p) and lambda0 (p);
+  // S u0 is then formed with a tight inner solve
+  const std::vector<real>* u0 = nullptr;
+  const std::vector<real>* lambda0 = nullptr;
 };
 
 struct NewtonResult {

@@ -1,0 +1,217 @@
+// The matrix-free semismooth* Newton solver against a dense reference
+// implementation of method.md §4 written here: the paper's full 4p system
+// (G A + H) Δ = (G + H) v̂ with A built from a dense Schur complement, solved
+// by LU, no reduction. Plus the KKT conditions, thread independence and the
+// paper's Table 1 mesh sizes.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <Eigen/Dense>
+
+#include "core/report.hpp"
+#include "core/run.hpp"
+#include "dense_reference.hpp"
+
+namespace tresca {
+
+namespace {
+
+struct DenseNewton {
+  std::vector<real> history;
+  std::vector<Eigen::VectorXd> iterates;  // x_0 .. x_final, node-major (u_x, u_y, u_z, lambda)
+  Eigen::VectorXd x;
+  int iterations = 0;
+};
+
+// Dense semismooth* Newton (paper Section 4) in node-major ordering x^i = (u_τ, u_ν, λ).
+DenseNewton dense_newton(const Eigen::MatrixXd& S, const Eigen::VectorXd& bt, real phi, real eps, int maxit) {
+  const index p = S.rows() / 3, n = 4 * p;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+  for (index i = 0; i < p; ++i) {
+    for (index j = 0; j < p; ++j)
+      for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c) A(4 * i + a, 4 * j + c) = S(a * p + i, c * p + j);
+    A(4 * i + 2, 4 * i + 3) = -1;  // F_3 = (S u − b̃)_z − λ
+    A(4 * i + 3, 4 * i + 2) = 1;   // F_4 = u_z
+    for (int a = 0; a < 3; ++a) b[4 * i + a] = bt[a * p + i];
+  }
+  DenseNewton R;
+  R.x = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k <= maxit; ++k) {
+    const Eigen::VectorXd F = A * R.x - b;
+    Eigen::VectorXd v(n), d(n);
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n), H = Eigen::MatrixXd::Zero(n, n);
+    for (index i = 0; i < p; ++i) {
+      const Eigen::Vector2d x12(R.x[4 * i], R.x[4 * i + 1]);
+      // (i) min ½|v|² + <F_12, v> + phi |x_12 + v|: prox of phi|.| at x_12 − F_12
+      const Eigen::Vector2d z = x12 - Eigen::Vector2d(F[4 * i], F[4 * i + 1]);
+      const Eigen::Vector2d d12 = z.norm() > phi ? Eigen::Vector2d((1 - phi / z.norm()) * z) : Eigen::Vector2d::Zero();
+      v.segment<2>(4 * i) = d12 - x12;
+      // (ii) min ½v² + F_3 v
+      v[4 * i + 2] = -F[4 * i + 2];
+      // (iii) min ½v² + x_3 v  over x_4 + v >= 0
+      v[4 * i + 3] = std::max(-R.x[4 * i + 2], -R.x[4 * i + 3]);
+      const real d4 = R.x[4 * i + 3] + v[4 * i + 3];
+      if (d12.norm() == 0) {
+        H.block<2, 2>(4 * i, 4 * i).setIdentity();
+      } else {
+        G.block<2, 2>(4 * i, 4 * i).setIdentity();
+        const real c = phi / std::pow(d12.norm(), 3);
+        H(4 * i, 4 * i) = c * d12[1] * d12[1];
+        H(4 * i, 4 * i + 1) = H(4 * i + 1, 4 * i) = -c * d12[0] * d12[1];
+        H(4 * i + 1, 4 * i + 1) = c * d12[0] * d12[0];
+      }
+      G(4 * i + 2, 4 * i + 2) = 1;
+      if (d4 > 0)
+        G(4 * i + 3, 4 * i + 3) = 1;
+      else
+        H(4 * i + 3, 4 * i + 3) = 1;
+    }
+    R.history.push_back(v.norm());
+    R.iterates.push_back(R.x);
+    if (v.norm() <= eps || k == maxit) break;
+    const Eigen::VectorXd delta = (G * A + H).partialPivLu().solve((G + H) * v);
+    R.x += delta;
+    R.iterations = k + 1;
+  }
+  return R;
+}
+
+// max-norm errors of (u, lambda) of a matrix-free iterate against a dense one
+std::pair<real, real> iterate_errors(const std::vector<real>& u, const std::vector<real>& lam, const Eigen::VectorXd& x,
+                                     real& umax, real& lmax) {
+  const index p = index(lam.size());
+  real uerr = 0, lerr = 0;
+  umax = lmax = 0;
+  for (index i = 0; i < p; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      uerr = std::max(uerr, std::abs(u[a * p + i] - x[4 * i + a]));
+      umax = std::max(umax, std::abs(x[4 * i + a]));
+    }
+    lerr = std::max(lerr, std::abs(lam[i] - x[4 * i + 3]));
+    lmax = std::max(lmax, std::abs(x[4 * i + 3]));
+  }
+  return {uerr, lerr};
+}
+
+// Runs both solvers; checks (a) the Newton map: from every dense iterate x_k
+// one matrix-free step gives x_{k+1}; (b) the final solutions agree; (c) KKT.
+void compare_with_dense(index ex, index ey, index ez, real phi, bool expect_mixed, bool same_path) {
+  ProblemSpec spec = spec_for_dims(ex, ey, ez);
+  spec.phi = phi;
+  RunOptions o;
+  o.recover_interior = false;
+  const RunResult R = run_tresca(spec, o);
+  ASSERT_TRUE(R.newton.converged()) << to_string(R.newton.reason);
+  const DenseSchur D = dense_schur(*R.problem);
+  const DenseNewton ref = dense_newton(D.S, D.b, phi, 1e-6, 60);
+  ASSERT_LE(ref.history.back(), 1e-6) << "dense reference did not converge";
+  const index p = R.problem->contact_nodes();
+
+  // (a) the Newton map, step by step from the reference iterates
+  SteklovPoincare S(*R.problem);
+  const std::vector<real> bt(D.b.data(), D.b.data() + 3 * p);
+  for (int k = 0; k + 1 < int(ref.iterates.size()); ++k) {
+    std::vector<real> u0(3 * p), l0(p);
+    for (index i = 0; i < p; ++i) {
+      for (int a = 0; a < 3; ++a) u0[a * p + i] = ref.iterates[k][4 * i + a];
+      l0[i] = ref.iterates[k][4 * i + 3];
+    }
+    NewtonOptions no;
+    no.max_iterations = 1;
+    no.u0 = &u0;
+    no.lambda0 = &l0;
+    const NewtonResult step = semismooth_newton(S, bt, phi, no);
+    EXPECT_NEAR(step.history[0], ref.history[k], 1e-8 * ref.history[k] + 1e-12 * ref.history[0]) << "k=" << k;
+    real umax, lmax;
+    const auto e = iterate_errors(step.u, step.lambda, ref.iterates[k + 1], umax, lmax);
+    EXPECT_LE(e.first, 1e-8 * umax) << "u after step " << k + 1;
+    EXPECT_LE(e.second, 1e-8 * lmax) << "lambda after step " << k + 1;
+  }
+  // (b) whole runs: same path where no node decision is marginal, same solution always
+  if (same_path) {
+    EXPECT_EQ(R.newton.iterations, ref.iterations);
+    for (size_t k = 0; k < std::min(R.newton.history.size(), ref.history.size()); ++k)
+      if (ref.history[k] > 1e-6 * ref.history[0])
+        EXPECT_NEAR(R.newton.history[k], ref.history[k], 1e-6 * ref.history[k]) << "k=" << k;
+  }
+  real umax, lmax;
+  const auto e = iterate_errors(R.newton.u, R.newton.lambda, ref.x, umax, lmax);
+  EXPECT_LT(e.first, 1e-8 * umax);
+  EXPECT_LT(e.second, 1e-8 * lmax);
+  // (c) KKT at the solution (forces ~1e7 N, displacements ~0.1 m)
+  const FinalReport& F = R.report;
+  if (expect_mixed) {
+    EXPECT_GT(F.active, 0);
+    EXPECT_GT(F.separated, 0);
+    EXPECT_GT(F.sticking, 0);
+    EXPECT_GT(F.sliding, 0);
+  }
+  const real fscale = F.btilde_norm;
+  EXPECT_LT(F.equilibrium, 1e-10 * fscale);
+  EXPECT_LT(F.uz_violation, 1e-12);
+  EXPECT_LT(F.lambda_violation, 1e-10 * fscale);
+  EXPECT_LT(F.complementarity, 1e-10 * fscale);
+  EXPECT_LT(F.friction_bound, 1e-10 * fscale);
+  EXPECT_LT(F.friction_direction, 1e-10 * fscale);
+  EXPECT_EQ(F.stick_slip, 0.0);
+  EXPECT_LT(F.true_residual_relative, 1e-10);
+}
+
+}  // namespace
+
+TEST(SemismoothNewton, MatchesDenseReferenceAtPaperFriction) { compare_with_dense(8, 4, 4, 1.0, false, true); }
+
+TEST(SemismoothNewton, MatchesDenseReferenceWithStickSlipAndSeparation) { compare_with_dense(8, 4, 4, 1e7, true, false); }
+
+TEST(SemismoothNewton, MatchesDenseReferenceOnOddMesh) { compare_with_dense(7, 3, 3, 3e6, false, false); }
+
+TEST(SemismoothNewton, ResultsAgreeWithOneAndTwoThreads) {
+  ProblemSpec spec = spec_for_level(5);
+  spec.phi = 3e6;
+  RunOptions o;
+  o.recover_interior = false;
+  const int keep = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const RunResult a = run_tresca(spec, o);
+  omp_set_num_threads(2);
+  const RunResult b = run_tresca(spec, o);
+  omp_set_num_threads(keep);
+  ASSERT_TRUE(a.newton.converged());
+  ASSERT_EQ(a.newton.iterations, b.newton.iterations);
+  real err = 0, scale = 0;
+  for (size_t i = 0; i < a.newton.u.size(); ++i) {
+    err = std::max(err, std::abs(a.newton.u[i] - b.newton.u[i]));
+    scale = std::max(scale, std::abs(a.newton.u[i]));
+  }
+  EXPECT_LE(err, 1e-10 * scale);
+}
+
+TEST(SemismoothNewton, ReportsIterationLimitHonestly) {
+  ProblemSpec spec = spec_for_dims(8, 4, 4);
+  RunOptions o;
+  o.newton.max_iterations = 2;
+  o.recover_interior = false;
+  const RunResult R = run_tresca(spec, o);
+  EXPECT_FALSE(R.newton.converged());
+  EXPECT_EQ(R.newton.reason, NewtonReason::iteration_limit);
+  EXPECT_EQ(R.newton.iterations, 2);
+  EXPECT_EQ(R.newton.history.size(), 3u);
+  EXPECT_GT(R.newton.history.back(), 1e-6);
+}
+
+TEST(Problem, MeshSizesMatchPaperTable1) {
+  const long long n[] = {225, 637, 1377, 4056, 9537, 27072, 70785};
+  const long long p[] = {40, 84, 144, 299, 544, 1104, 2112};
+  for (int level = 2; level <= 8; ++level) {
+    const Problem P = make_problem(spec_for_level(level));
+    EXPECT_EQ(P.nodes(), n[level - 2]) << "level " << level;
+    EXPECT_EQ(P.contact_nodes(), p[level - 2]) << "level " << level;
+  }
+  const Problem P1 = make_problem(spec_for_level(1));
+  EXPECT_EQ(P1.nodes(), 112);  // method.md §1: the formula's level 1 (the paper repeats level 2)
+  EXPECT_EQ(P1.contact_nodes(), 24);
+}
+
+}  // namespace tresca
