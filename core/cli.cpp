@@ -113,7 +113,8 @@ void check_memory(const ProblemSpec& s) {
   const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
   if (have > 0 && need > 0.9 * have) {
     std::ostringstream os;
-    os << "mesh " << dims_string(s) << " needs about " << need / 1e9 << " GB, more than this machine's "
+    if (s.level >= 0) os << "level " << s.level << " (";
+    os << "mesh " << dims_string(s) << (s.level >= 0 ? ")" : "") << " needs about " << need / 1e9 << " GB, more than this machine's "
        << have / 1e9 << " GB";
     fail(os.str());
   }

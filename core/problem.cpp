@@ -62,6 +62,7 @@ void validate(const ProblemSpec& s) {
   }
   const double nodes = double(s.ex + 1) * double(s.ey + 1) * double(s.ez + 1);
   if (nodes > 4e8) {
+    if (s.level >= 0) os << "level " << s.level << ": ";
     os << "mesh " << s.ex << "x" << s.ey << "x" << s.ez << " has " << nodes << " nodes, beyond what this code can address";
     fail(os.str());
   }

@@ -52,7 +52,7 @@ const PaperRow* paper_row(int level) {
   return nullptr;
 }
 
-std::string summary_json(const ProblemSpec& spec, const RunResult& R, int threads) {
+std::string summary_json(const ProblemSpec& spec, const RunResult& R, int threads, double eps) {
   const Problem& P = *R.problem;
   const FinalReport& F = R.report;
   const NewtonResult& N = R.newton;
@@ -74,7 +74,7 @@ std::string summary_json(const ProblemSpec& spec, const RunResult& R, int thread
     j.null("level");
   j.raw("dims", "[" + std::to_string(spec.ex) + ", " + std::to_string(spec.ey) + ", " + std::to_string(spec.ez) + "]")
       .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
-      .num("phi", spec.phi).num("eps", 0).integer("threads", threads).integer("newton_iterations", N.iterations)
+      .num("phi", spec.phi).num("eps", eps).integer("threads", threads).integer("newton_iterations", N.iterations)
       .boolean("converged", N.converged()).str("reason", to_string(N.reason))
       .array("residual_history", N.history).num("final_residual", N.history.empty() ? 0 : N.history.back())
       .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
@@ -161,7 +161,7 @@ int main(int argc, char** argv) {
                     R.report.true_residual, R.report.true_residual_relative);
         std::fflush(stdout);
         all = all && R.newton.converged();
-        rows += (rows.size() > 1 ? ",\n " : "") + summary_json(s, R, threads);
+        rows += (rows.size() > 1 ? ",\n " : "") + summary_json(s, R, threads, opt.newton.eps);
       }
       if (!json_path.empty()) write_file_atomic(json_path, rows + "]\n");
       return all ? 0 : 1;
@@ -197,7 +197,7 @@ int main(int argc, char** argv) {
     if (profile) std::printf("\n%s", profile_table(R.times.total).c_str());
     try {
       const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status};
-      if (!json_path.empty()) write_file_atomic(json_path, summary_json(spec, R, threads) + "\n");
+      if (!json_path.empty()) write_file_atomic(json_path, summary_json(spec, R, threads, opt.newton.eps) + "\n");
       if (!csv_path.empty()) write_contact_csv(csv_path, *R.problem, cf);
       if (!vtk_path.empty()) {
         const std::string second = write_vtu(vtk_path, *R.problem, R.u_full, cf);

@@ -1,0 +1,122 @@
+// The command-line drivers: bad input gives a one-line error naming the value
+// and exit status 2; a run that does not converge says so (status 1); output
+// files have the documented content.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <algorithm>
+#include <string>
+#include <sys/wait.h>
+
+namespace tresca {
+
+namespace {
+struct CmdResult {
+  int status;
+  std::string out;  // stdout and stderr together
+};
+
+CmdResult run(const std::string& args) {
+  const std::string cmd = std::string(TRESCA_BIN_DIR) + "/" + args + " 2>&1";
+  CmdResult r{-1, ""};
+  FILE* f = popen(cmd.c_str(), "r");
+  if (!f) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, f)) > 0) r.out.append(buf, n);
+  const int st = pclose(f);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+void expect_error(const std::string& args, const std::string& names) {
+  const CmdResult r = run(args);
+  EXPECT_EQ(r.status, 2) << args << "\n" << r.out;
+  EXPECT_NE(r.out.find(names), std::string::npos) << args << "\n" << r.out;
+  EXPECT_NE(r.out.find("error"), std::string::npos) << r.out;
+  EXPECT_LE(std::count(r.out.begin(), r.out.end(), '\n'), 1) << "one line: " << r.out;
+}
+}  // namespace
+
+TEST(ElasticDriver, RejectsBadInputWithOneLineNamingTheValue) {
+  expect_error("elastic --level -1", "-1");
+  expect_error("elastic --level 15", "level 15");
+  expect_error("elastic --level 19", "level 19");
+  expect_error("elastic --nu 0.5", "0.5");
+  expect_error("elastic --E -3", "-3");
+  expect_error("elastic --E 0", "E = 0");
+  expect_error("elastic --dims 4x4", "4x4");
+  expect_error("elastic --dims 4x0x3", "4x0x3");
+  expect_error("elastic --dims axbxc", "axbxc");
+  expect_error("elastic --level abc", "abc");
+  expect_error("elastic --frobnicate", "--frobnicate");
+}
+
+TEST(ElasticDriver, SolvesTheInteriorProblem) {
+  const CmdResult r = run("elastic --dims 6x3x3");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("converged"), std::string::npos);
+}
+
+TEST(TrescaDriver, RejectsBadOptions) {
+  expect_error("tresca --bogus", "--bogus");
+  expect_error("tresca --dims 4x2x2 --phi -1", "-1");
+  expect_error("tresca --dims 4x2x2 --eps 0", "--eps 0");
+  expect_error("tresca --dims 4x2x2 --eps -1e-3", "-1e-3");
+  expect_error("tresca --dims 4x2x2 --json /nonexistent-dir/out.json", "/nonexistent-dir/out.json");
+  expect_error("tresca --dims 4x2x2 --threads 0", "--threads 0");
+  expect_error("tresca --table 3-1", "3-1");
+  expect_error("tresca --level", "--level");
+}
+
+TEST(TrescaDriver, ReportsNonConvergenceInOutputAndExitStatus) {
+  const CmdResult r = run("tresca --dims 8x4x4 --max-newton 1 --quiet");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("NOT CONVERGED"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("iteration_limit"), std::string::npos) << r.out;
+}
+
+TEST(TrescaDriver, WritesJsonCsvAndVtk) {
+  const std::string dir = std::string(TRESCA_BIN_DIR) + "/../";
+  const std::string json = dir + "t_out.json", csv = dir + "t_out.csv", vtu = dir + "t_out.vtu";
+  const CmdResult r = run("tresca --dims 6x3x2 --phi 1e7 --quiet --json " + json + " --contact-csv " + csv + " --vtk " + vtu);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::string j = slurp(json);
+  for (const char* key : {"\"level\": null", "\"dims\": [6, 3, 2]", "\"nodes\": 84", "\"contact_nodes\": 24",
+                          "\"dofs\"", "\"phi\": 10000000", "\"eps\"", "\"threads\"", "\"newton_iterations\"",
+                          "\"converged\": true", "\"reason\": \"converged\"", "\"residual_history\": [",
+                          "\"final_residual\"", "\"true_residual\"", "\"true_residual_relative\"", "\"times\": {\"setup\"",
+                          "\"condense\"", "\"solve\"", "\"recover\"", "\"total\"", "\"counts\": {\"inner_iterations\"",
+                          "\"outer_iterations\"", "\"operator_applications\"", "\"contact\": {\"active\"", "\"separated\"",
+                          "\"sticking\"", "\"sliding\"", "\"ux_min\"", "\"uz_max\"", "\"lambda_sum\""})
+    EXPECT_NE(j.find(key), std::string::npos) << key << " in " << j;
+  EXPECT_EQ(j.find("\"eps\": 0,"), std::string::npos) << "eps must be the tolerance used";
+  const std::string c = slurp(csv);
+  EXPECT_EQ(c.rfind("ix,iy,x,y,ux,uy,uz,lambda,contact,stick\n", 0), 0u);
+  EXPECT_EQ(std::count(c.begin(), c.end(), '\n'), 1 + 24);
+  const std::string v = slurp(vtu), vc = slurp(dir + "t_out_contact.vtu");
+  EXPECT_NE(v.find("NumberOfPoints=\"84\" NumberOfCells=\"36\""), std::string::npos);
+  EXPECT_NE(v.find("Name=\"displacement\""), std::string::npos);
+  EXPECT_NE(v.find("</VTKFile>"), std::string::npos);
+  EXPECT_NE(vc.find("NumberOfPoints=\"28\" NumberOfCells=\"18\""), std::string::npos);
+  std::ifstream tmp(json + ".tmp");
+  EXPECT_FALSE(tmp.good()) << "temporary file left behind";
+}
+
+TEST(TrescaDriver, TablePrintsPaperColumnsAndConverges) {
+  const CmdResult r = run("tresca --table 2-3");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("    2       225"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("    3       637"), std::string::npos) << r.out;
+}
+
+}  // namespace tresca
