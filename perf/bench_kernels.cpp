@@ -1,0 +1,94 @@
+// Kernel benchmarks (Google Benchmark). Rates use the cost models stated in
+// the kernel headers: apply 48 B and 102 flop per dof (kernels/elasticity.hpp).
+//   OMP_NUM_THREADS=2 build/bin/bench_kernels --benchmark_filter=Apply
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <vector>
+
+#include "core/multigrid.hpp"
+#include "core/problem.hpp"
+#include "kernels/transfer.hpp"
+#include "kernels/vector_ops.hpp"
+
+namespace tresca {
+namespace {
+
+std::vector<real> ramp(index n) {
+  std::vector<real> v(n);
+  for (index i = 0; i < n; ++i) v[i] = real((i * 7919) % 1000) * 1e-3;
+  return v;
+}
+
+void set_rates(benchmark::State& st, double dofs, double bytes_per_dof, double flops_per_dof) {
+  const double it = double(st.iterations());
+  st.counters["DoF/s"] = benchmark::Counter(dofs * it, benchmark::Counter::kIsRate);
+  st.counters["bytes/s"] = benchmark::Counter(dofs * bytes_per_dof * it, benchmark::Counter::kIsRate);
+  st.counters["FLOP/s"] = benchmark::Counter(dofs * flops_per_dof * it, benchmark::Counter::kIsRate);
+  st.counters["threads"] = omp_get_max_threads();
+  st.counters["dofs"] = dofs;
+}
+
+template <bool kRef>
+void BM_Apply(benchmark::State& st) {
+  const Problem P = make_problem(spec_for_level(int(st.range(0))));
+  const ElasticityStencil k = build_elasticity_stencil(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+  auto x = ramp(k.size());
+  std::vector<real> y(k.size());
+  for (auto _ : st) {
+    if (kRef)
+      elasticity_apply_ref(k, x.data(), y.data(), 0, P.grid.nz());
+    else
+      elasticity_apply(k, x.data(), y.data(), 0, P.grid.nz());
+    benchmark::DoNotOptimize(y.data());
+    benchmark::ClobberMemory();
+  }
+  set_rates(st, double(k.size()), 16, 102);
+}
+BENCHMARK_TEMPLATE(BM_Apply, false)->Name("Apply")->DenseRange(6, 11)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Apply, true)->Name("ApplyRef")->DenseRange(3, 6)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void BM_VCycle(benchmark::State& st) {
+  const Problem P = make_problem(spec_for_level(int(st.range(0))));
+  Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+  auto r = ramp(P.dofs());
+  zero_constrained(P.grid, P.interior_faces, r.data());
+  std::vector<real> z(P.dofs());
+  for (auto _ : st) {
+    mg.apply(r.data(), z.data());
+    benchmark::DoNotOptimize(z.data());
+  }
+  set_rates(st, double(P.dofs()), 0, 0);
+}
+BENCHMARK(BM_VCycle)->Name("VCycle")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void BM_Transfer(benchmark::State& st) {
+  const Problem P = make_problem(spec_for_level(int(st.range(0))));
+  GridDims c = P.grid;
+  c.ex = (c.ex + 1) / 2;
+  c.ey = (c.ey + 1) / 2;
+  c.ez = (c.ez + 1) / 2;
+  const Transfer t = build_transfer(P.grid, c);
+  auto f = ramp(3 * P.grid.nodes());
+  std::vector<real> cc(3 * c.nodes());
+  for (auto _ : st) {
+    restrict_to_coarse(t, 3, f.data(), cc.data());
+    prolongate(t, 3, cc.data(), f.data());
+    benchmark::DoNotOptimize(f.data());
+  }
+  set_rates(st, double(3 * P.grid.nodes()), 2 * 8 * 1.25, 0);
+}
+BENCHMARK(BM_Transfer)->Name("RestrictProlong")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void BM_Dot(benchmark::State& st) {
+  const index n = index(st.range(0));
+  auto x = ramp(n), y = ramp(n);
+  for (auto _ : st) benchmark::DoNotOptimize(dot(n, x.data(), y.data()));
+  set_rates(st, double(n), 16, 2);
+}
+BENCHMARK(BM_Dot)->Name("Dot")->Arg(1 << 20)->Arg(1 << 24)->UseRealTime();
+
+}  // namespace
+}  // namespace tresca
+
+BENCHMARK_MAIN();
