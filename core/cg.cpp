@@ -59,14 +59,21 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
       return st;
     }
     A.apply(p, q);
-    const real pq = dot(n, p, q);
+    real pq;
+    {
+      ScopedTimer t(Kernel::vector, 16.0 * n, 2.0 * n);
+      pq = dot(n, p, q);
+    }
     if (!(pq > 0)) {
       st.reason = std::isfinite(pq) ? SolveReason::breakdown : SolveReason::non_finite;
       return st;
     }
     const real alpha = rz / pq;
     if (opt.on_step) opt.on_step(alpha);
-    rr = cg_update(n, alpha, p, q, x, r);
+    {
+      ScopedTimer t(Kernel::vector, 48.0 * n, 6.0 * n);
+      rr = cg_update(n, alpha, p, q, x, r);
+    }
     st.iterations = it;
     st.residual = std::sqrt(rr);
     if (!std::isfinite(rr)) {
@@ -76,6 +83,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
     if (st.residual <= target) return st;
     if (opt.on_residual) opt.on_residual(st.residual);
     precondition();
+    ScopedTimer t(Kernel::vector, 40.0 * n, 4.0 * n);
     const real rz_new = dot(n, r, z);
     xpay(n, z, rz_new / rz, p);
     rz = rz_new;

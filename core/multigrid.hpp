@@ -35,7 +35,7 @@ namespace tresca {
 struct MGOptions {
   int degree = 3;
   real range = 15;
-  index coarse_nodes = 1200;
+  index coarse_nodes = 400;
 };
 
 class Multigrid : public LinearOperator {

@@ -1,6 +1,7 @@
 #include "profile.hpp"
 
 #include <omp.h>
+#include <sys/resource.h>
 
 #include <cstdio>
 
@@ -18,6 +19,12 @@ const char* kernel_name(Kernel k) {
 }
 
 double wall_time() { return omp_get_wtime(); }
+
+double peak_memory_bytes() {
+  struct rusage ru;
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_maxrss) * 1024.0;  // Linux reports kilobytes
+}
 
 void profile_add(Kernel k, double seconds, double bytes, double flops) {
   // called from the serial driver thread only (kernels parallelise inside)
@@ -43,14 +50,16 @@ std::string profile_table(double total) {
   for (int i = 0; i < int(Kernel::count); ++i) {
     const ProfileEntry& e = g_entries[i];
     if (e.calls == 0) continue;
-    const bool nested = Kernel(i) == Kernel::inner_cg || Kernel(i) == Kernel::outer_cg;
+    // rows that contain other rows, or have no traffic model, show no rates
+    const bool nested = Kernel(i) == Kernel::inner_cg || Kernel(i) == Kernel::outer_cg ||
+                        Kernel(i) == Kernel::smoother || Kernel(i) == Kernel::coarse_solve;
     std::snprintf(line, sizeof line, "%-22s %10lld %10.3f %6.1f%% %9s %9s\n", kernel_name(Kernel(i)), e.calls,
                   e.seconds, total > 0 ? 100 * e.seconds / total : 0.0,
                   nested || e.seconds <= 0 ? "-" : std::to_string(e.bytes / e.seconds * 1e-9).substr(0, 6).c_str(),
                   nested || e.seconds <= 0 ? "-" : std::to_string(e.flops / e.seconds * 1e-9).substr(0, 6).c_str());
     out += line;
   }
-  out += "(inner/outer CG rows include the kernels above; their share overlaps)\n";
+  out += "(smoother, inner and outer CG rows contain the kernel rows; their shares overlap)\n";
   return out;
 }
 

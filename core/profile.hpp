@@ -26,6 +26,8 @@ void profile_reset();
 std::string profile_table(double total_seconds);
 
 double wall_time();
+// peak resident memory of this process so far, in bytes (getrusage)
+double peak_memory_bytes();
 
 class ScopedTimer {
  public:

@@ -28,6 +28,13 @@ struct RunResult {
   FinalReport report;
   std::vector<real> u_full;  // 3N SoA (empty if not recovered)
   long long inner_iterations = 0;  // over the whole run, including condensation and recovery
+  // work of the Newton phase in fine-grid matvec equivalents: all applies of
+  // K on every multigrid level, weighted by their size relative to the fine grid
+  double fine_matvecs_solve = 0;
+  double peak_memory = 0;  // bytes, process peak resident set after the run
+  double fine_matvecs_per_newton_step() const {
+    return newton.iterations > 0 ? fine_matvecs_solve / newton.iterations : 0;
+  }
 };
 
 RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt);

@@ -61,7 +61,8 @@ std::string summary_json(const ProblemSpec& spec, const RunResult& R, int thread
       .num("recover", R.times.recover).num("total", R.times.total);
   counts.integer("inner_iterations", R.inner_iterations).integer("outer_iterations", N.outer_iterations)
       .integer("operator_applications", N.operator_applications)
-      .integer("newton_inner_iterations", N.inner_iterations);
+      .integer("newton_inner_iterations", N.inner_iterations)
+      .num("fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step());
   contact.integer("active", F.active).integer("separated", F.separated).integer("sticking", F.sticking)
       .integer("sliding", F.sliding).num("ux_min", F.ux_min).num("uz_max", F.uz_max).num("lambda_sum", F.lambda_sum);
   kkt.num("equilibrium", F.equilibrium).num("uz_violation", F.uz_violation).num("lambda_violation", F.lambda_violation)
@@ -79,7 +80,7 @@ std::string summary_json(const ProblemSpec& spec, const RunResult& R, int thread
       .array("residual_history", N.history).num("final_residual", N.history.empty() ? 0 : N.history.back())
       .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
       .raw("times", times.render()).raw("counts", counts.render()).raw("contact", contact.render())
-      .raw("kkt", kkt.render());
+      .raw("kkt", kkt.render()).num("peak_memory_bytes", R.peak_memory);
   return j.render();
 }
 
@@ -175,7 +176,6 @@ int main(int argc, char** argv) {
                   opt.newton.eps, threads);
       std::printf("        estimated peak memory %.2f GB\n", estimated_memory_bytes(spec) / 1e9);
     }
-    opt.recover_interior = !vtk_path.empty() || profile || true;
     const RunResult R = run_tresca(spec, opt);
     const NewtonResult& N = R.newton;
     const FinalReport& F = R.report;
@@ -192,6 +192,8 @@ int main(int argc, char** argv) {
                 F.uz_max, F.lambda_sum);
     std::printf("work: %lld inner CG iterations, %lld outer CG iterations, %lld S applications\n", R.inner_iterations,
                 N.outer_iterations, N.operator_applications);
+    std::printf("work: %.1f fine-grid matvec equivalents per Newton step; peak memory %.2f GB\n",
+                R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9);
     std::printf("times [s]: setup %.3f, condense %.3f, solve %.3f, recover %.3f, total %.3f\n", R.times.setup,
                 R.times.condense, R.times.solve, R.times.recover, R.times.total);
     if (profile) std::printf("\n%s", profile_table(R.times.total).c_str());

@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
     const std::string json = a.str("--json");
     if (!json.empty()) check_writable(json);
     for (int L : levels) check_memory(spec_for_level(L));
-    std::printf("%5s %11s %-34s %6s %9s %9s %11s %s\n", "level", "dofs", "hierarchy", "iters", "setup[s]", "solve[s]",
+    std::printf("%5s %11s %-52s %6s %9s %9s %11s %s\n", "level", "dofs", "hierarchy", "iters", "setup[s]", "solve[s]",
                 "s/iter", "rel.res (recomputed)");
     std::string rows = "[";
     for (int L : levels) {
@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
       mg.op(0).apply(u.data(), r.data());
       axpy(P.dofs(), -1, b.data(), r.data());
       const double rel = norm2(P.dofs(), r.data()) / st.rhs_norm;
-      std::printf("%5d %11lld %-34s %6d %9.3f %9.3f %11.4f %.2e %s\n", L, (long long)P.dofs(), mg.describe().c_str(),
+      std::printf("%5d %11lld %-52s %6d %9.3f %9.3f %11.4f %.2e %s\n", L, (long long)P.dofs(), mg.describe().c_str(),
                   st.iterations, t1 - t0, t2 - t1, (t2 - t1) / std::max(1, st.iterations), rel,
                   st.ok() ? "" : to_string(st.reason));
       std::fflush(stdout);
