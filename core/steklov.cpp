@@ -50,27 +50,39 @@ SolveStats SteklovPoincare::solve_interior(const real* rhs, real* z) const {
   return st;
 }
 
-void SteklovPoincare::apply(const real* v, real* Sv) const {
+void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
   const GridDims& g = P_.grid;
-  const index n = 3 * P_.nodes(), N = P_.nodes(), plane = g.nx() * g.ny();
-  fill(n, 0, w_.data());
+  const index plane = g.nx() * g.ny(), N = P_.nodes();
+  for (int a = 0; a < 3; ++a) {
+    real* dst = v + a * N + iz * plane;
+    if (src)
+      copy(plane, src + a * N + iz * plane, dst);
+    else
+      fill(plane, 0, dst);
+  }
+}
+
+void SteklovPoincare::apply(const real* v, real* Sv) const {
+  // Invariants between calls: w_ is zero off the contact nodes, t_ is zero
+  // off plane 1, so only plane-sized work surrounds the inner solve.
+  const GridDims& g = P_.grid;
+  const index N = P_.nodes(), plane = g.nx() * g.ny();
   scatter(v, w_.data());
-  // t = -K_ic v on plane 1, zero elsewhere
-  fill(n, 0, t_.data());
-  K_.apply_planes(w_.data(), t_.data(), 1, std::min<index>(2, g.nz()));
+  // t = -K_ic v lives on plane 1 (w_ is zero on the x = 0 nodes, so are t's)
+  K_.apply_planes(w_.data(), t_.data(), 1, 2);
   for (int a = 0; a < 3; ++a) scale(plane, -1, t_.data() + a * N + plane);
-  zero_constrained(g, P_.interior_faces, t_.data());
   solve_interior(t_.data(), z_.data());
-  // u = w + z ; Sv = (K u)_c on plane 0
-  axpy(n, 1, w_.data(), z_.data());
+  // u = w + z: z vanishes on the constrained plane 0, where w lives
+  set_plane(z_.data(), 0, w_.data());
+  // Sv = (K u)_c on plane 0, then restore t_'s invariant
   K_.apply_planes(z_.data(), t_.data(), 0, 1);
   gather(t_.data(), Sv);
+  set_plane(t_.data(), 0, nullptr);
 }
 
 std::vector<real> SteklovPoincare::condensed_load(real rtol) const {
   const real keep = inner_rtol_;
   inner_rtol_ = rtol;
-  const index n = 3 * P_.nodes();
   std::vector<real> li(P_.load);
   zero_constrained(P_.grid, P_.interior_faces, li.data());
   solve_interior(li.data(), z_.data());
@@ -78,28 +90,27 @@ std::vector<real> SteklovPoincare::condensed_load(real rtol) const {
   K_.apply_planes(z_.data(), t_.data(), 0, 1);
   std::vector<real> b(3 * p_), lc(3 * p_);
   gather(t_.data(), b.data());
+  set_plane(t_.data(), 0, nullptr);
   gather(P_.load.data(), lc.data());
   for (index i = 0; i < 3 * p_; ++i) b[i] = lc[i] - b[i];
-  (void)n;
   return b;
 }
 
 std::vector<real> SteklovPoincare::recover(const real* uc, real rtol) const {
-  const GridDims& g = P_.grid;
+  // rhs = l_i - K_ic u_c (K_ic u_c lives on plane 1); u = w + K_ii^{-1} rhs.
+  // Reuses w_ and t_ (no extra full-size vectors at peak), then restores t_.
   const index n = 3 * P_.nodes();
-  fill(n, 0, w_.data());
+  std::vector<real> u(n);
   scatter(uc, w_.data());
-  // rhs = l_i - K_ic u_c  (K_ic u_c lives on plane 1)
-  fill(n, 0, t_.data());
-  K_.apply_planes(w_.data(), t_.data(), 1, std::min<index>(2, g.nz()));
+  K_.apply_planes(w_.data(), t_.data(), 1, 2);
   xpay(n, P_.load.data(), -1, t_.data());
-  zero_constrained(g, P_.interior_faces, t_.data());
+  zero_constrained(P_.grid, P_.interior_faces, t_.data());
   const real keep = inner_rtol_;
   inner_rtol_ = rtol;
-  std::vector<real> u(n);
   solve_interior(t_.data(), u.data());
   inner_rtol_ = keep;
-  axpy(n, 1, w_.data(), u.data());
+  set_plane(u.data(), 0, w_.data());
+  fill(n, 0, t_.data());
   return u;
 }
 

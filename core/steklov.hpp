@@ -53,6 +53,8 @@ class SteklovPoincare : public LinearOperator {
 
  private:
   SolveStats solve_interior(const real* rhs, real* z) const;
+  // plane iz of all 3 components of v := src's (or 0 if src is null)
+  void set_plane(real* v, index iz, const real* src) const;
 
   const Problem& P_;
   index p_;

@@ -28,40 +28,54 @@ std::uint8_t axis_class(index i, index n, bool c_lo, bool c_hi) {
 // element, node is its local 0) contribute, and whether the neighbour is dropped.
 bool dropped(std::uint8_t c, int d) { return (d < 0 && (c & kDropL)) || (d > 0 && (c & kDropR)); }
 
-template <int W>
-inline void stencil_block(const StencilEntry* e, const StencilEntry* e_end, const real* x, real* y) {
-  real acc[W];
-  for (int l = 0; l < W; ++l) acc[l] = 0;
-  for (; e != e_end; ++e) {
-    const real* xp = x + e->off;
-    const real c = e->c;
+// Accumulates the groups [g, ge) whose nonzero outputs are the mask M.
+template <int W, int M>
+inline void accumulate(const StencilGroup* g, const StencilGroup* ge, const real* x, real* a0, real* a1, real* a2) {
+  for (; g != ge; ++g) {
+    const real* xp = x + g->off;
+    const real c0 = g->c[0], c1 = g->c[1], c2 = g->c[2];
 #pragma omp simd
-    for (int l = 0; l < W; ++l) acc[l] += c * xp[l];
+    for (int l = 0; l < W; ++l) {
+      const real v = xp[l];
+      if (M & 1) a0[l] += c0 * v;
+      if (M & 2) a1[l] += c1 * v;
+      if (M & 4) a2[l] += c2 * v;
+    }
   }
-  for (int l = 0; l < W; ++l) y[l] = acc[l];
 }
 
-// y_a[i] = sum_e c_e x[i + off_e] for i in [i0, i1) and the 3 output
-// components a, block by block so that the ~7 KB input window of a block is
-// reused from L1 by all three components. `first` are the 4 entry offsets of
-// this stencil's components.
+// y_a[i..i+W) for the 3 output components of one stencil; f = first + 7*s.
 template <int W>
-inline void stencil_block3(const StencilEntry* e, const std::int32_t* first, const real* x, real* y, index N,
-                           index i) {
-  for (int a = 0; a < 3; ++a) stencil_block<W>(e + first[a], e + first[a + 1], x + i, y + a * N + i);
+inline void stencil_block(const StencilGroup* g, const std::int32_t* f, const real* x, real* y, index N, index i) {
+  real a0[W], a1[W], a2[W];
+  for (int l = 0; l < W; ++l) a0[l] = a1[l] = a2[l] = 0;
+  x += i;
+  accumulate<W, 1>(g + f[0], g + f[1], x, a0, a1, a2);
+  accumulate<W, 2>(g + f[1], g + f[2], x, a0, a1, a2);
+  accumulate<W, 3>(g + f[2], g + f[3], x, a0, a1, a2);
+  accumulate<W, 4>(g + f[3], g + f[4], x, a0, a1, a2);
+  accumulate<W, 5>(g + f[4], g + f[5], x, a0, a1, a2);
+  accumulate<W, 6>(g + f[5], g + f[6], x, a0, a1, a2);
+  accumulate<W, 7>(g + f[6], g + f[7], x, a0, a1, a2);
+  for (int l = 0; l < W; ++l) {
+    y[i + l] = a0[l];
+    y[N + i + l] = a1[l];
+    y[2 * N + i + l] = a2[l];
+  }
 }
 
-inline void stencil_range(const StencilEntry* e, const std::int32_t* first, const real* x, real* y, index N,
-                          index i0, index i1) {
+inline void stencil_range(const StencilGroup* g, const std::int32_t* f, const real* x, real* y, index N, index i0,
+                          index i1) {
+  constexpr int kW = 16;
   index i = i0;
-  for (; i + 32 <= i1; i += 32) stencil_block3<32>(e, first, x, y, N, i);
-  for (; i + 8 <= i1; i += 8) stencil_block3<8>(e, first, x, y, N, i);
+  for (; i + kW <= i1; i += kW) stencil_block<kW>(g, f, x, y, N, i);
+  for (; i + 8 <= i1; i += 8) stencil_block<8>(g, f, x, y, N, i);
   if (i < i1 && i1 - i0 >= 8) {
     // finish with one overlapping block: recomputes a few outputs of the same run
-    stencil_block3<8>(e, first, x, y, N, i1 - 8);
+    stencil_block<8>(g, f, x, y, N, i1 - 8);
     return;
   }
-  for (; i < i1; ++i) stencil_block3<1>(e, first, x, y, N, i);
+  for (; i < i1; ++i) stencil_block<1>(g, f, x, y, N, i);
 }
 
 }  // namespace
@@ -117,22 +131,30 @@ ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, re
               for (int b = 0; b < 3; ++b) S[di][a][b] += k.Ke[24 * (3 * L + a) + 3 * M + b];
           }
         }
-        const std::int32_t s = std::int32_t(k.first.size() - 1) / 3;
+        const std::int32_t s = std::int32_t(k.first.size() - 1) / 7;
         k.slot[(cx * 32 + cy) * 32 + cz] = s;
         real scale = 0;
         for (int a = 0; a < 3; ++a) scale = std::max(scale, std::abs(S[13][a][a]));
-        for (int a = 0; a < 3; ++a) {
-          for (int di = 0; di < 27; ++di) {
-            const index dx = di % 3 - 1, dy = (di / 3) % 3 - 1, dz = di / 9 - 1;
-            for (int b = 0; b < 3; ++b) {
+        std::vector<StencilGroup> by_mask[8];
+        for (int di = 0; di < 27; ++di) {
+          const index dx = di % 3 - 1, dy = (di / 3) % 3 - 1, dz = di / 9 - 1;
+          for (int b = 0; b < 3; ++b) {
+            StencilGroup grp{b * N + dx + g.nx() * (dy + g.ny() * dz), {0, 0, 0}};
+            int mask = 0;
+            for (int a = 0; a < 3; ++a)
               // exact cancellations leave round-off of order 1e-16*scale
-              if (std::abs(S[di][a][b]) <= 1e-12 * scale) continue;
-              k.entries.push_back({b * N + dx + g.nx() * (dy + g.ny() * dz), S[di][a][b]});
-            }
+              if (std::abs(S[di][a][b]) > 1e-12 * scale) {
+                grp.c[a] = S[di][a][b];
+                mask |= 1 << a;
+              }
+            if (mask) by_mask[mask].push_back(grp);
           }
-          k.first.push_back(std::int32_t(k.entries.size()));
-          k.center.push_back(S[13][a][a]);
         }
+        for (int m = 1; m < 8; ++m) {
+          k.groups.insert(k.groups.end(), by_mask[m].begin(), by_mask[m].end());
+          k.first.push_back(std::int32_t(k.groups.size()));
+        }
+        for (int a = 0; a < 3; ++a) k.center.push_back(S[13][a][a]);
       }
   return k;
 }
@@ -163,7 +185,7 @@ void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index 
             continue;
           }
           const std::int32_t s = k.slot[(cx * 32 + cy) * 32 + cz];
-          stencil_range(k.entries.data(), k.first.data() + 3 * s, x + row, y + row, N, i0, i1);
+          stencil_range(k.groups.data(), k.first.data() + 7 * s, x + row, y + row, N, i0, i1);
         }
       }
 }
@@ -238,13 +260,26 @@ void elasticity_diagonal_ref(const ElasticityStencil& k, real* d) {
 }
 
 void zero_constrained(const GridDims& g, unsigned faces, real* v) {
-  const index N = g.nodes();
-#pragma omp parallel for collapse(2) schedule(static)
-  for (index iz = 0; iz < g.nz(); ++iz)
-    for (index iy = 0; iy < g.ny(); ++iy)
-      for (index ix = 0; ix < g.nx(); ++ix)
-        if (node_constrained(g, faces, ix, iy, iz))
-          for (int a = 0; a < 3; ++a) v[a * N + g.node(ix, iy, iz)] = 0;
+  // touches only the constrained faces: O(surface), not O(volume)
+  const index nx = g.nx(), ny = g.ny(), nz = g.nz(), N = g.nodes();
+  for (int a = 0; a < 3; ++a) {
+    real* c = v + a * N;
+    if (faces & (kFaceZ0 | kFaceZ1))
+      for (index iz : {index(0), nz - 1})
+        if ((iz == 0 && (faces & kFaceZ0)) || (iz == nz - 1 && (faces & kFaceZ1)))
+          for (index n = 0; n < nx * ny; ++n) c[n + nx * ny * iz] = 0;
+    for (index iz = 0; iz < nz; ++iz) {
+      if (faces & kFaceY0)
+        for (index ix = 0; ix < nx; ++ix) c[g.node(ix, 0, iz)] = 0;
+      if (faces & kFaceY1)
+        for (index ix = 0; ix < nx; ++ix) c[g.node(ix, ny - 1, iz)] = 0;
+      if (faces & (kFaceX0 | kFaceX1))
+        for (index iy = 0; iy < ny; ++iy) {
+          if (faces & kFaceX0) c[g.node(0, iy, iz)] = 0;
+          if (faces & kFaceX1) c[g.node(nx - 1, iy, iz)] = 0;
+        }
+    }
+  }
 }
 
 }  // namespace tresca

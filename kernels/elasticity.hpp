@@ -32,9 +32,9 @@
 
 namespace tresca {
 
-struct StencilEntry {
+struct StencilGroup {
   index off;  // b*N + dx + nx*(dy + ny*dz): input offset relative to the output node
-  real c;     // coupling coefficient K[(p,a),(q,b)]
+  real c[3];  // couplings K[(p,a),(p+d,b)] for output components a = 0,1,2
 };
 
 struct ElasticityStencil {
@@ -49,11 +49,11 @@ struct ElasticityStencil {
   std::vector<std::uint8_t> cls[3];
   // x-runs: maximal ranges of ix with the same x-class: [run_begin[r], run_begin[r+1])
   std::vector<index> run_begin;
-  // stencils: id = slot[(cx*32 + cy)*32 + cz]; entries of output component a of
-  // stencil s are entries[first[3*s+a] .. first[3*s+a+1])
+  // stencils: id = slot[(cx*32 + cy)*32 + cz]; the groups of stencil s whose
+  // nonzero outputs form mask m (1..7) are groups[first[7*s+m-1] .. first[7*s+m])
   std::vector<std::int32_t> slot;
   std::vector<std::int32_t> first;
-  std::vector<StencilEntry> entries;
+  std::vector<StencilGroup> groups;
   std::vector<real> center;  // diagonal coefficient per stencil and component: center[3*s+a]
 
   index nodes() const { return g.nodes(); }

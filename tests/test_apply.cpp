@@ -134,6 +134,23 @@ TEST(ElasticityApply, PatchTestLinearFieldHasZeroInteriorResidual) {
   EXPECT_LT(interior, 1e-12 * boundary);
 }
 
+TEST(ZeroConstrained, ZeroesExactlyTheConstrainedFaces) {
+  for (auto& s : kSizes)
+    for (unsigned faces : kFaceSets) {
+      const GridDims g = dims(s[0], s[1], s[2]);
+      auto v = random_vector(3 * g.nodes(), 9);
+      const auto before = v;
+      zero_constrained(g, faces, v.data());
+      for (index iz = 0; iz < g.nz(); ++iz)
+        for (index iy = 0; iy < g.ny(); ++iy)
+          for (index ix = 0; ix < g.nx(); ++ix)
+            for (int a = 0; a < 3; ++a) {
+              const index i = a * g.nodes() + g.node(ix, iy, iz);
+              EXPECT_EQ(v[i], node_constrained(g, faces, ix, iy, iz) ? 0.0 : before[i]);
+            }
+    }
+}
+
 TEST(BottomBlock, OptimisedEqualsReferenceAndAssembly) {
   const GridDims g = dims(4, 3, 2);
   ElasticityOperator A(g, kFaceX0, 1.0, 0.3);
