@@ -20,7 +20,21 @@ void ElasticityOperator::apply_planes(const real* x, real* y, index z_begin, ind
   if (!B_.empty() && z_begin == 0 && z_end > 0) {
     const double m = double(g.nx()) * double(g.ny());
     ScopedTimer t(Kernel::apply_boundary, m * 80, m * 10);
-    bottom_block_apply(g, B_.data(), x, y);
+    bottom_block_apply(g, 1, B_.data(), x, y);
+  }
+}
+
+void ElasticityOperator::residual(const real* b, const real* x, real* r) const {
+  const GridDims& g = k_.g;
+  {
+    const double nodes = double(g.nodes());
+    ScopedTimer t(Kernel::apply, nodes * 72, nodes * 315);
+    elasticity_apply(k_, x, r, 0, g.nz(), b);
+  }
+  if (!B_.empty()) {
+    const double m = double(g.nx()) * double(g.ny());
+    ScopedTimer t(Kernel::apply_boundary, m * 80, m * 13);
+    bottom_block_apply(g, -1, B_.data(), x, r);
   }
 }
 

@@ -20,6 +20,8 @@ class ElasticityOperator : public LinearOperator {
   void apply(const real* x, real* y) const override;
   // y = (K + B) x on output planes [z_begin, z_end) only
   void apply_planes(const real* x, real* y, index z_begin, index z_end) const;
+  // r = b - (K + B) x, fused into the apply (no separate vector pass)
+  void residual(const real* b, const real* x, real* r) const;
 
   const GridDims& grid() const { return k_.g; }
   unsigned faces() const { return k_.faces; }

@@ -131,10 +131,7 @@ void Multigrid::smooth(int l, bool zero_guess) const {
   real* x = lv.x.data();
   real* r = lv.r.data();
   real* d = lv.d.data();
-  auto residual = [&] {
-    lv.A.apply(x, r);
-    xpay(n, lv.b.data(), -1, r);  // r = b - A x
-  };
+  auto residual = [&] { lv.A.residual(lv.b.data(), x, r); };
   if (zero_guess) {
     fill(n, 0, x);
     copy(n, lv.b.data(), r);
@@ -165,8 +162,7 @@ void Multigrid::vcycle(int l) const {
   const index n = lv.A.size();
   const Level& c = levels_[l + 1];
   smooth(l, true);
-  lv.A.apply(lv.x.data(), lv.r.data());
-  xpay(n, lv.b.data(), -1, lv.r.data());
+  lv.A.residual(lv.b.data(), lv.x.data(), lv.r.data());
   {
     const double nf = double(n);
     ScopedTimer t(Kernel::restrict_, nf * 8 * 1.3, nf * 2 * 8 / 8 * 8);

@@ -27,7 +27,7 @@ namespace {
 class ReducedNewtonOperator : public LinearOperator {
  public:
   ReducedNewtonOperator(const SteklovPoincare& S, const std::vector<real>& h, const std::vector<std::uint8_t>& free)
-      : S_(S), h_(h), free_(free), Sx(S.size()) {}
+      : Sx(S.size()), S_(S), h_(h), free_(free) {}
   index size() const override { return S_.size(); }
   void apply(const real* x, real* y) const override {
     S_.apply(x, Sx.data());

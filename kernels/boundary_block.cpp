@@ -2,24 +2,24 @@
 
 namespace tresca {
 
-void bottom_block_apply(const GridDims& g, const real* B, const real* x, real* y) {
+void bottom_block_apply(const GridDims& g, real alpha, const real* B, const real* x, real* y) {
   const index M = g.nx() * g.ny(), N = g.nodes();
   const real *bxx = B, *bxy = B + M, *byy = B + 2 * M, *bzz = B + 3 * M;
 #pragma omp parallel for simd schedule(static) if (M > 4096)
   for (index n = 0; n < M; ++n) {
     const real ux = x[n], uy = x[N + n], uz = x[2 * N + n];
-    y[n] += bxx[n] * ux + bxy[n] * uy;
-    y[N + n] += bxy[n] * ux + byy[n] * uy;
-    y[2 * N + n] += bzz[n] * uz;
+    y[n] += alpha * (bxx[n] * ux + bxy[n] * uy);
+    y[N + n] += alpha * (bxy[n] * ux + byy[n] * uy);
+    y[2 * N + n] += alpha * bzz[n] * uz;
   }
 }
 
-void bottom_block_apply_ref(const GridDims& g, const real* B, const real* x, real* y) {
+void bottom_block_apply_ref(const GridDims& g, real alpha, const real* B, const real* x, real* y) {
   const index M = g.nx() * g.ny(), N = g.nodes();
   for (index n = 0; n < M; ++n) {
     const real b[3][3] = {{B[n], B[M + n], 0}, {B[M + n], B[2 * M + n], 0}, {0, 0, B[3 * M + n]}};
     for (int a = 0; a < 3; ++a)
-      for (int c = 0; c < 3; ++c) y[a * N + n] += b[a][c] * x[c * N + n];
+      for (int c = 0; c < 3; ++c) y[a * N + n] += alpha * b[a][c] * x[c * N + n];
   }
 }
 

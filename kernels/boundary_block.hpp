@@ -1,7 +1,7 @@
 // Symmetric 3x3 blocks on the bottom face (iz = 0), the boundary term of the
 // Newton-step preconditioner (method.md §4, H and the fixed-dof penalties):
 //
-//   y(n) += B(n) x(n),  B = [[bxx, bxy, 0], [bxy, byy, 0], [0, 0, bzz]]
+//   y(n) += alpha B(n) x(n),  B = [[bxx, bxy, 0], [bxy, byy, 0], [0, 0, bzz]]
 //
 // DATA LAYOUT: B is 4 consecutive fields of nx*ny values (bxx, bxy, byy, bzz)
 // indexed by ix + nx*iy; x, y are SoA grid fields (grid.hpp).
@@ -11,7 +11,7 @@
 
 namespace tresca {
 
-void bottom_block_apply(const GridDims& g, const real* B, const real* x, real* y);
-void bottom_block_apply_ref(const GridDims& g, const real* B, const real* x, real* y);
+void bottom_block_apply(const GridDims& g, real alpha, const real* B, const real* x, real* y);
+void bottom_block_apply_ref(const GridDims& g, real alpha, const real* B, const real* x, real* y);
 
 }  // namespace tresca

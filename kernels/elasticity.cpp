@@ -46,7 +46,8 @@ inline void accumulate(const StencilGroup* g, const StencilGroup* ge, const real
 
 // y_a[i..i+W) for the 3 output components of one stencil; f = first + 7*s.
 template <int W>
-inline void stencil_block(const StencilGroup* g, const std::int32_t* f, const real* x, real* y, index N, index i) {
+inline void stencil_block(const StencilGroup* g, const std::int32_t* f, const real* x, real* y, const real* b,
+                          index N, index i) {
   real a0[W], a1[W], a2[W];
   for (int l = 0; l < W; ++l) a0[l] = a1[l] = a2[l] = 0;
   x += i;
@@ -57,25 +58,33 @@ inline void stencil_block(const StencilGroup* g, const std::int32_t* f, const re
   accumulate<W, 5>(g + f[4], g + f[5], x, a0, a1, a2);
   accumulate<W, 6>(g + f[5], g + f[6], x, a0, a1, a2);
   accumulate<W, 7>(g + f[6], g + f[7], x, a0, a1, a2);
-  for (int l = 0; l < W; ++l) {
-    y[i + l] = a0[l];
-    y[N + i + l] = a1[l];
-    y[2 * N + i + l] = a2[l];
+  if (b) {
+    for (int l = 0; l < W; ++l) {
+      y[i + l] = b[i + l] - a0[l];
+      y[N + i + l] = b[N + i + l] - a1[l];
+      y[2 * N + i + l] = b[2 * N + i + l] - a2[l];
+    }
+  } else {
+    for (int l = 0; l < W; ++l) {
+      y[i + l] = a0[l];
+      y[N + i + l] = a1[l];
+      y[2 * N + i + l] = a2[l];
+    }
   }
 }
 
-inline void stencil_range(const StencilGroup* g, const std::int32_t* f, const real* x, real* y, index N, index i0,
-                          index i1) {
+inline void stencil_range(const StencilGroup* g, const std::int32_t* f, const real* x, real* y, const real* b,
+                          index N, index i0, index i1) {
   constexpr int kW = 16;
   index i = i0;
-  for (; i + kW <= i1; i += kW) stencil_block<kW>(g, f, x, y, N, i);
-  for (; i + 8 <= i1; i += 8) stencil_block<8>(g, f, x, y, N, i);
+  for (; i + kW <= i1; i += kW) stencil_block<kW>(g, f, x, y, b, N, i);
+  for (; i + 8 <= i1; i += 8) stencil_block<8>(g, f, x, y, b, N, i);
   if (i < i1 && i1 - i0 >= 8) {
     // finish with one overlapping block: recomputes a few outputs of the same run
-    stencil_block<8>(g, f, x, y, N, i1 - 8);
+    stencil_block<8>(g, f, x, y, b, N, i1 - 8);
     return;
   }
-  for (; i < i1; ++i) stencil_block<1>(g, f, x, y, N, i);
+  for (; i < i1; ++i) stencil_block<1>(g, f, x, y, b, N, i);
 }
 
 }  // namespace
@@ -159,7 +168,8 @@ ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, re
   return k;
 }
 
-void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end) {
+void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
+                      const real* b) {
   const GridDims& g = k.g;
   const index nx = g.nx(), ny = g.ny(), N = g.nodes();
   const index nruns = index(k.run_begin.size()) - 1;
@@ -170,9 +180,9 @@ void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index 
   const index nbands = std::max<index>(1, nthreads * ((ny + nthreads * kBand - 1) / (nthreads * kBand)));
   const index band = (ny + nbands - 1) / nbands;
 #pragma omp parallel for schedule(static)
-  for (index b = 0; b < nbands; ++b)
+  for (index bnd = 0; bnd < nbands; ++bnd)
     for (index iz = z_begin; iz < z_end; ++iz)
-      for (index iy = b * band; iy < std::min(ny, (b + 1) * band); ++iy) {
+      for (index iy = bnd * band; iy < std::min(ny, (bnd + 1) * band); ++iy) {
         const std::uint8_t cy = k.cls[1][iy], cz = k.cls[2][iz];
         const index row = nx * (iy + ny * iz);
         const bool row_fixed = (cy & kSelf) || (cz & kSelf);
@@ -181,16 +191,20 @@ void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index 
           const std::uint8_t cx = k.cls[0][i0];
           if (row_fixed || (cx & kSelf)) {
             for (int a = 0; a < 3; ++a)
-              for (index i = i0; i < i1; ++i) y[a * N + row + i] = x[a * N + row + i];
+              for (index i = i0; i < i1; ++i) {
+                const index j = a * N + row + i;
+                y[j] = b ? b[j] - x[j] : x[j];
+              }
             continue;
           }
           const std::int32_t s = k.slot[(cx * 32 + cy) * 32 + cz];
-          stencil_range(k.groups.data(), k.first.data() + 7 * s, x + row, y + row, N, i0, i1);
+          stencil_range(k.groups.data(), k.first.data() + 7 * s, x + row, y + row, b ? b + row : nullptr, N, i0, i1);
         }
       }
 }
 
-void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end) {
+void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
+                          const real* b) {
   const GridDims& g = k.g;
   const index N = g.nodes();
   for (index iz = z_begin; iz < z_end; ++iz)
@@ -222,8 +236,11 @@ void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, in
   for (index iz = z_begin; iz < z_end; ++iz)
     for (index iy = 0; iy < g.ny(); ++iy)
       for (index ix = 0; ix < g.nx(); ++ix)
-        if (node_constrained(g, k.faces, ix, iy, iz))
-          for (int a = 0; a < 3; ++a) y[a * N + g.node(ix, iy, iz)] = x[a * N + g.node(ix, iy, iz)];
+        for (int a = 0; a < 3; ++a) {
+          const index j = a * N + g.node(ix, iy, iz);
+          if (node_constrained(g, k.faces, ix, iy, iz)) y[j] = x[j];
+          if (b) y[j] = b[j] - y[j];
+        }
 }
 
 void elasticity_diagonal(const ElasticityStencil& k, real* d) {

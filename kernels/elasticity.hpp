@@ -64,9 +64,13 @@ struct ElasticityStencil {
 ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, real E, real nu);
 
 // y = K x for output planes iz in [z_begin, z_end) (the whole grid with
-// z_begin = 0, z_end = g.nz()). OpenMP over x-rows.
-void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end);
-void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end);
+// z_begin = 0, z_end = g.nz()). With b != nullptr the residual y = b - K x is
+// written instead (fused: one extra input stream, no extra pass). OpenMP over
+// x-rows.
+void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
+                      const real* b = nullptr);
+void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
+                          const real* b = nullptr);
 
 // d = diag(K) (1 on constrained dofs).
 void elasticity_diagonal(const ElasticityStencil& k, real* d);

@@ -62,6 +62,18 @@ TEST(ElasticityApply, OptimisedEqualsReferenceIncludingPlaneRanges) {
         elasticity_apply(k, x.data(), y.data(), zb, ze);
         elasticity_apply_ref(k, x.data(), yr.data(), zb, ze);
         EXPECT_LT(max_abs_diff(y, yr), 1e-13 * max_abs(yr));
+        // fused residual r = b - K x
+        auto b = random_vector(k.size(), 6);
+        std::vector<real> r(k.size(), 7.0), rr(k.size(), 7.0);
+        elasticity_apply(k, x.data(), r.data(), zb, ze, b.data());
+        elasticity_apply_ref(k, x.data(), rr.data(), zb, ze, b.data());
+        EXPECT_LT(max_abs_diff(r, rr), 1e-13 * max_abs(yr));
+        for (index iz = zb; iz < ze; ++iz)
+          for (index n = iz * g.nx() * g.ny(); n < (iz + 1) * g.nx() * g.ny(); ++n)
+            for (int a = 0; a < 3; ++a) {
+              const index j = a * g.nodes() + n;
+              EXPECT_NEAR(r[j], b[j] - yr[j], 1e-13 * max_abs(yr));
+            }
       }
       std::vector<real> d(k.size()), dr(k.size());
       elasticity_diagonal(k, d.data());
@@ -158,14 +170,21 @@ TEST(BottomBlock, OptimisedEqualsReferenceAndAssembly) {
   A.set_bottom_block(random_vector(4 * M, 21));
   auto x = random_vector(A.size(), 22);
   std::vector<real> y(A.size(), 0), yr(A.size(), 0);
-  bottom_block_apply(g, A.bottom_block().data(), x.data(), y.data());
-  bottom_block_apply_ref(g, A.bottom_block().data(), x.data(), yr.data());
+  bottom_block_apply(g, 0.5, A.bottom_block().data(), x.data(), y.data());
+  bottom_block_apply_ref(g, 0.5, A.bottom_block().data(), x.data(), yr.data());
   EXPECT_LT(max_abs_diff(y, yr), 1e-15);
   const SparseMatrix K = assemble(A);
   Eigen::Map<const Eigen::VectorXd> xv(x.data(), A.size());
   Eigen::VectorXd ye = K * xv;
   auto ya = matvec(A, x);
   EXPECT_LT(max_abs_diff(ya, std::vector<real>(ye.data(), ye.data() + A.size())), 1e-12 * ye.cwiseAbs().maxCoeff());
+  // residual with the block: r = b - (K + B) x
+  auto b = random_vector(A.size(), 23);
+  std::vector<real> r(A.size());
+  A.residual(b.data(), x.data(), r.data());
+  real err = 0;
+  for (index i = 0; i < A.size(); ++i) err = std::max(err, std::abs(r[i] - (b[i] - ye[i])));
+  EXPECT_LT(err, 1e-12 * ye.cwiseAbs().maxCoeff());
 }
 
 }  // namespace tresca

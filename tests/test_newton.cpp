@@ -133,8 +133,9 @@ void compare_with_dense(index ex, index ey, index ez, real phi, bool expect_mixe
   if (same_path) {
     EXPECT_EQ(R.newton.iterations, ref.iterations);
     for (size_t k = 0; k < std::min(R.newton.history.size(), ref.history.size()); ++k)
-      if (ref.history[k] > 1e-6 * ref.history[0])
+      if (ref.history[k] > 1e-6 * ref.history[0]) {
         EXPECT_NEAR(R.newton.history[k], ref.history[k], 1e-6 * ref.history[k]) << "k=" << k;
+      }
   }
   real umax, lmax;
   const auto e = iterate_errors(R.newton.u, R.newton.lambda, ref.x, umax, lmax);
