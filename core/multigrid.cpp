@@ -26,13 +26,19 @@ Multigrid::Multigrid(const GridDims& fine, unsigned faces, real E, real nu, cons
     Level lv;
     lv.A = ElasticityOperator(g, faces, E, nu);
     const index n = lv.A.size();
-    lv.x.resize(n);
-    lv.b.resize(n);
+    if (!levels_.empty()) {  // level 0 solves in the caller's arrays
+      lv.x.resize(n);
+      lv.b.resize(n);
+    }
     lv.r.resize(n);
     lv.d.resize(n);
     const bool last = g.nodes() <= opt.coarse_nodes || (g.ex == 1 && g.ey == 1 && g.ez == 1);
     if (!last) lv.to_coarse = build_transfer(g, coarsen(g));
     levels_.push_back(std::move(lv));
+    if (levels_.size() > 1) {
+      levels_.back().xp = levels_.back().x.data();
+      levels_.back().bp = levels_.back().b.data();
+    }
     if (last) break;
     g = coarsen(g);
   }
@@ -128,21 +134,19 @@ void Multigrid::smooth(int l, bool zero_guess) const {
   ScopedTimer t(Kernel::smoother);
   const real lmax = lv.lmax, lmin = lmax / opt_.range;
   const real theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
-  real* x = lv.x.data();
+  real* x = lv.xp;
   real* r = lv.r.data();
   real* d = lv.d.data();
-  auto residual = [&] { lv.A.residual(lv.b.data(), x, r); };
   if (zero_guess) {
-    fill(n, 0, x);
-    copy(n, lv.b.data(), r);
+    cheb_first(n, 1 / theta, lv.dinv.data(), lv.bp, d, x);
   } else {
-    residual();
+    lv.A.residual(lv.bp, x, r);
+    fill(n, 0, d);
+    cheb_update(n, 0, 1 / theta, lv.dinv.data(), r, d, x);
   }
-  fill(n, 0, d);
-  cheb_update(n, 0, 1 / theta, lv.dinv.data(), r, d, x);
   real rho = 1 / sigma;
   for (int k = 1; k < opt_.degree; ++k) {
-    residual();
+    lv.A.residual(lv.bp, x, r);
     const real rho_new = 1 / (2 * sigma - rho);
     cheb_update(n, rho_new * rho, 2 * rho_new / delta, lv.dinv.data(), r, d, x);
     rho = rho_new;
@@ -151,18 +155,17 @@ void Multigrid::smooth(int l, bool zero_guess) const {
 
 void Multigrid::vcycle(int l) const {
   const Level& lv = levels_[l];
+  const index n = lv.A.size();
   if (l + 1 == int(levels_.size())) {
     ScopedTimer t(Kernel::coarse_solve);
-    const index n = lv.A.size();
-    for (index i = 0; i < n; ++i) cb_[i] = lv.b[i];
+    for (index i = 0; i < n; ++i) cb_[i] = lv.bp[i];
     cx_ = coarse_.solve(cb_);
-    for (index i = 0; i < n; ++i) lv.x[i] = cx_[i];
+    for (index i = 0; i < n; ++i) lv.xp[i] = cx_[i];
     return;
   }
-  const index n = lv.A.size();
   const Level& c = levels_[l + 1];
   smooth(l, true);
-  lv.A.residual(lv.b.data(), lv.x.data(), lv.r.data());
+  lv.A.residual(lv.bp, lv.xp, lv.r.data());
   {
     const double nf = double(n);
     ScopedTimer t(Kernel::restrict_, nf * 8 * 1.3, nf * 2 * 8 / 8 * 8);
@@ -171,20 +174,20 @@ void Multigrid::vcycle(int l) const {
   }
   vcycle(l + 1);
   {
+    // x += P x_c; the correction vanishes on constrained faces (they are
+    // interpolated from constrained coarse nodes only), the mask makes it exact
     const double nf = double(n);
-    ScopedTimer t(Kernel::prolongate, nf * 8 * 1.3, nf * 15);
-    prolongate(lv.to_coarse, 3, c.x.data(), lv.d.data());
-    zero_constrained(lv.A.grid(), lv.A.faces(), lv.d.data());
+    ScopedTimer t(Kernel::prolongate, nf * 8 * 2.3, nf * 16);
+    prolongate(lv.to_coarse, 3, c.x.data(), lv.xp, true);
+    zero_constrained(lv.A.grid(), lv.A.faces(), lv.xp);
   }
-  axpy(n, 1, lv.d.data(), lv.x.data());
   smooth(l, false);
 }
 
 void Multigrid::apply(const real* r, real* z) const {
-  const index n = size();
-  copy(n, r, levels_[0].b.data());
+  levels_[0].bp = r;
+  levels_[0].xp = z;
   vcycle(0);
-  copy(n, levels_[0].x.data(), z);
 }
 
 std::string Multigrid::describe() const {

@@ -57,7 +57,9 @@ class Multigrid : public LinearOperator {
     std::vector<real> dinv;
     real lmax = 0;
     Transfer to_coarse;  // to the next level (unused on the coarsest)
-    mutable std::vector<real> x, b, r, d;
+    mutable std::vector<real> x, b, r, d;  // owned storage (x, b unused on level 0)
+    mutable real* xp = nullptr;            // iterate and right-hand side in use:
+    mutable const real* bp = nullptr;      // the caller's arrays on level 0
   };
   void vcycle(int l) const;
   void smooth(int l, bool zero_guess) const;

@@ -17,9 +17,10 @@ const char* kernel_name(Kernel k);
 struct ProfileEntry {
   long long calls = 0;
   double seconds = 0, bytes = 0, flops = 0;
+  double items = 0;  // work items (grid nodes for the apply), for fine-matvec equivalents
 };
 
-void profile_add(Kernel k, double seconds, double bytes, double flops);
+void profile_add(Kernel k, double seconds, double bytes, double flops, double items = 0);
 ProfileEntry profile_get(Kernel k);
 void profile_reset();
 // Table with calls, time, share of `total_seconds`, GB/s and GFLOP/s.
@@ -31,14 +32,15 @@ double peak_memory_bytes();
 
 class ScopedTimer {
  public:
-  ScopedTimer(Kernel k, double bytes = 0, double flops = 0) : k_(k), b_(bytes), f_(flops), t0_(wall_time()) {}
-  ~ScopedTimer() { profile_add(k_, wall_time() - t0_, b_, f_); }
+  ScopedTimer(Kernel k, double bytes = 0, double flops = 0, double items = 0)
+      : k_(k), b_(bytes), f_(flops), n_(items), t0_(wall_time()) {}
+  ~ScopedTimer() { profile_add(k_, wall_time() - t0_, b_, f_, n_); }
   ScopedTimer(const ScopedTimer&) = delete;
   ScopedTimer& operator=(const ScopedTimer&) = delete;
 
  private:
   Kernel k_;
-  double b_, f_, t0_;
+  double b_, f_, n_, t0_;
 };
 
 }  // namespace tresca

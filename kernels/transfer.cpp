@@ -47,7 +47,7 @@ Transfer build_transfer(const GridDims& fine, const GridDims& coarse) {
   return t;
 }
 
-void prolongate(const Transfer& t, int comps, const real* coarse, real* fine) {
+void prolongate(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate) {
   const GridDims &f = t.fine, &c = t.coarse;
   const index Nf = f.nodes(), Nc = c.nodes();
   const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
@@ -68,13 +68,13 @@ void prolongate(const Transfer& t, int comps, const real* coarse, real* fine) {
           const real s0 = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
           const real s1 =
               w00 * u[b00 + j + 1] + w10 * u[b10 + j + 1] + w01 * u[b01 + j + 1] + w11 * u[b11 + j + 1];
-          v[ix] = (1 - wx) * s0 + wx * s1;
+          v[ix] = (accumulate ? v[ix] : 0) + (1 - wx) * s0 + wx * s1;
         }
       }
     }
 }
 
-void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine) {
+void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate) {
   const GridDims &f = t.fine, &c = t.coarse;
   for (int a = 0; a < comps; ++a)
     for (index iz = 0; iz < f.nz(); ++iz)
@@ -89,7 +89,8 @@ void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine
             s += w * coarse[a * c.nodes() +
                             c.node(t.axis[0].j0[ix] + bx, t.axis[1].j0[iy] + by, t.axis[2].j0[iz] + bz)];
           }
-          fine[a * f.nodes() + f.node(ix, iy, iz)] = s;
+          real& out = fine[a * f.nodes() + f.node(ix, iy, iz)];
+          out = accumulate ? out + s : s;
         }
 }
 

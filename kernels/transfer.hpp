@@ -38,9 +38,9 @@ struct Transfer {
 
 Transfer build_transfer(const GridDims& fine, const GridDims& coarse);
 
-// fine = P coarse, for `comps` components
-void prolongate(const Transfer& t, int comps, const real* coarse, real* fine);
-void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine);
+// fine = P coarse (or fine += P coarse with accumulate), for `comps` components
+void prolongate(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate = false);
+void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate = false);
 // coarse = P^T fine
 void restrict_to_coarse(const Transfer& t, int comps, const real* fine, real* coarse);
 void restrict_to_coarse_ref(const Transfer& t, int comps, const real* fine, real* coarse);

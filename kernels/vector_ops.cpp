@@ -94,6 +94,11 @@ void cheb_update(index n, real s, real t, const real* dinv, const real* r, real*
   }
 }
 
+void cheb_first(index n, real t, const real* dinv, const real* b, real* d, real* x) {
+#pragma omp parallel for simd schedule(static)
+  for (index i = 0; i < n; ++i) x[i] = d[i] = t * dinv[i] * b[i];
+}
+
 bool all_finite(index n, const real* x) {
   return blocked_sum(n, [=](index i) { return std::isfinite(x[i]) ? real(0) : real(1); }) == 0;
 }

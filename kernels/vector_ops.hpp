@@ -7,7 +7,8 @@
 // Cost models (bytes moved, flops), n entries of 8 bytes:
 //   dot 16n B, 2n F;  axpy 24n B, 2n F;  xpay 24n B, 2n F;
 //   cg_update (x += a p, r -= a q, returns r.r) 48n B, 6n F;
-//   cheb_update (d = s d + t Dinv r, x += d) 40n B, 5n F.
+//   cheb_update (d = s d + t Dinv r, x += d) 40n B, 5n F;
+//   cheb_first (d = t Dinv b, x = d) 32n B, 2n F.
 #pragma once
 #include "types.hpp"
 
@@ -29,6 +30,8 @@ real cg_update(index n, real a, const real* p, const real* q, real* x, real* r);
 real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real* r);
 // d = s d + t dinv .* r; x += d
 void cheb_update(index n, real s, real t, const real* dinv, const real* r, real* d, real* x);
+// first Chebyshev step from x = 0: d = t dinv .* b; x = d
+void cheb_first(index n, real t, const real* dinv, const real* b, real* d, real* x);
 // true if every entry is finite
 bool all_finite(index n, const real* x);
 

@@ -35,6 +35,12 @@ TEST(Transfer, OptimisedEqualsReferenceOnNonNestedGrids) {
     restrict_to_coarse(t, 2, f.data(), rc.data());
     restrict_to_coarse_ref(t, 2, f.data(), rcr.data());
     EXPECT_LT(max_abs_diff(pf, pfr), 1e-14);
+    // accumulate: fine += P coarse
+    std::vector<real> acc(f), accr(f);
+    prolongate(t, 2, c.data(), acc.data(), true);
+    prolongate_ref(t, 2, c.data(), accr.data(), true);
+    EXPECT_LT(max_abs_diff(acc, accr), 1e-14);
+    for (size_t i = 0; i < f.size(); ++i) EXPECT_NEAR(acc[i], f[i] + pfr[i], 1e-14);
     EXPECT_LT(max_abs_diff(rc, rcr), 1e-13);
     // <P c, f> = <c, P^T f>
     const real a = dot_ref(index(f.size()), pf.data(), f.data()), b = dot_ref(index(c.size()), c.data(), rc.data());
