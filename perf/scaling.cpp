@@ -75,7 +75,8 @@ int main(int argc, char** argv) {
             .integer("operator_applications", R.newton.operator_applications)
             .num("fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step())
             .num("peak_memory_bytes", R.peak_memory).num("speedup", speedup)
-            .num("true_residual_relative", R.report.true_residual_relative);
+            .num("true_residual_relative", R.report.true_residual_relative)
+            .num("lambda_sum", R.report.lambda_sum).num("ux_min", R.report.ux_min).num("uz_max", R.report.uz_max);
         rows += (rows.size() > 1 ? ",\n " : "") + j.render();
       }
     }
