@@ -87,18 +87,16 @@ std::string summary_json(const ProblemSpec& spec, const RunResult& R, int thread
 }  // namespace
 
 int main(int argc, char** argv) {
-  Args* args = nullptr;
   ProblemSpec spec;
   RunOptions opt;
   int threads = 1;
   std::string json_path, csv_path, vtk_path, table;
   bool quiet = false, profile = false;
   try {
-    static Args a(argc, argv,
+    const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
                    "--contact-csv", "--vtk", "--table"},
                   {"--quiet", "--help", "--profile"});
-    args = &a;
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
       return 0;
@@ -118,16 +116,15 @@ int main(int argc, char** argv) {
     json_path = a.str("--json");
     csv_path = a.str("--contact-csv");
     vtk_path = a.str("--vtk");
-    for (const std::string* p : {&json_path, &csv_path, &vtk_path})
-      if (a.has(p == &json_path ? "--json" : p == &csv_path ? "--contact-csv" : "--vtk")) {
-        if (p->empty()) throw std::invalid_argument("empty output file name");
-        check_writable(*p);
+    for (const char* flag : {"--json", "--contact-csv", "--vtk"})
+      if (a.has(flag)) {
+        if (a.str(flag).empty()) throw std::invalid_argument(std::string("empty file name for ") + flag);
+        check_writable(a.str(flag));
       }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());
     return 2;
   }
-  (void)args;
 
   try {
     if (!quiet)

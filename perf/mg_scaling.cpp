@@ -4,12 +4,10 @@
 #include <cstdio>
 #include <exception>
 
-#include "core/cg.hpp"
 #include "core/cli.hpp"
-#include "core/multigrid.hpp"
+#include "core/interior.hpp"
 #include "core/output.hpp"
 #include "core/profile.hpp"
-#include "kernels/vector_ops.hpp"
 
 using namespace tresca;
 
@@ -35,23 +33,16 @@ int main(int argc, char** argv) {
       const double t0 = wall_time();
       Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
       const double t1 = wall_time();
-      std::vector<real> b(P.load), u(P.dofs()), r(P.dofs());
-      zero_constrained(P.grid, P.interior_faces, b.data());
-      CGOptions o;
-      o.rtol = rtol;
-      CGWorkspace ws;
-      const SolveStats st = pcg(mg.op(0), &mg, b.data(), u.data(), o, ws);
-      const double t2 = wall_time();
-      mg.op(0).apply(u.data(), r.data());
-      axpy(P.dofs(), -1, b.data(), r.data());
-      const double rel = norm2(P.dofs(), r.data()) / st.rhs_norm;
+      const InteriorSolution sol = solve_interior_elasticity(P, mg, rtol);
+      const SolveStats& st = sol.stats;
+      const double solve = sol.seconds, rel = sol.relative_residual;
       std::printf("%5d %11lld %-52s %6d %9.3f %9.3f %11.4f %.2e %s\n", L, (long long)P.dofs(), mg.describe().c_str(),
-                  st.iterations, t1 - t0, t2 - t1, (t2 - t1) / std::max(1, st.iterations), rel,
+                  st.iterations, t1 - t0, solve, solve / std::max(1, st.iterations), rel,
                   st.ok() ? "" : to_string(st.reason));
       std::fflush(stdout);
       Json j;
       j.integer("level", L).integer("dofs", P.dofs()).integer("levels", mg.num_levels())
-          .integer("iterations", st.iterations).num("setup", t1 - t0).num("solve", t2 - t1)
+          .integer("iterations", st.iterations).num("setup", t1 - t0).num("solve", solve)
           .num("relative_residual", rel).str("reason", to_string(st.reason)).integer("threads", threads);
       rows += (rows.size() > 1 ? ",\n " : "") + j.render();
     }

@@ -16,16 +16,6 @@ using test::max_abs_diff;
 using test::random_vector;
 
 namespace {
-GridDims dims(index ex, index ey, index ez) {
-  GridDims g;
-  g.ex = ex;
-  g.ey = ey;
-  g.ez = ez;
-  g.lx = 2;
-  g.ly = 1;
-  g.lz = 0.9;
-  return g;
-}
 const unsigned kFaceSets[] = {0u, kFaceX0, kFaceX0 | kFaceZ0, 63u, kFaceY1 | kFaceZ1};
 const index kSizes[][3] = {{3, 2, 5}, {7, 3, 2}, {1, 1, 1}, {2, 1, 3}, {17, 3, 5}};
 
@@ -39,7 +29,7 @@ std::vector<real> matvec(const ElasticityOperator& A, const std::vector<real>& x
 TEST(ElasticityApply, MatchesAssembledMatrixOnOddSizes) {
   for (auto& s : kSizes)
     for (unsigned faces : kFaceSets) {
-      ElasticityOperator A(dims(s[0], s[1], s[2]), faces, 2.1e9, 0.277);
+      ElasticityOperator A(test::prism(s[0], s[1], s[2]), faces, 2.1e9, 0.277);
       const SparseMatrix K = assemble(A);
       auto x = random_vector(A.size(), 3);
       auto y = matvec(A, x);
@@ -53,7 +43,7 @@ TEST(ElasticityApply, MatchesAssembledMatrixOnOddSizes) {
 TEST(ElasticityApply, OptimisedEqualsReferenceIncludingPlaneRanges) {
   for (auto& s : kSizes)
     for (unsigned faces : kFaceSets) {
-      const GridDims g = dims(s[0], s[1], s[2]);
+      const GridDims g = test::prism(s[0], s[1], s[2]);
       const ElasticityStencil k = build_elasticity_stencil(g, faces, 1.0, 0.3);
       auto x = random_vector(k.size(), 5);
       for (index zb = 0; zb < g.nz(); ++zb) {
@@ -84,7 +74,7 @@ TEST(ElasticityApply, OptimisedEqualsReferenceIncludingPlaneRanges) {
 
 TEST(ElasticityApply, IsSymmetric) {
   for (unsigned faces : kFaceSets) {
-    ElasticityOperator A(dims(7, 3, 2), faces, 2.1e9, 0.277);
+    ElasticityOperator A(test::prism(7, 3, 2), faces, 2.1e9, 0.277);
     auto x = random_vector(A.size(), 11), y = random_vector(A.size(), 12);
     auto Ax = matvec(A, x), Ay = matvec(A, y);
     const real xay = dot_ref(A.size(), x.data(), Ay.data()), yax = dot_ref(A.size(), y.data(), Ax.data());
@@ -93,7 +83,7 @@ TEST(ElasticityApply, IsSymmetric) {
 }
 
 TEST(ElasticityApply, RigidBodyModesLieInKernelWithoutDirichlet) {
-  const GridDims g = dims(5, 3, 4);
+  const GridDims g = test::prism(5, 3, 4);
   ElasticityOperator A(g, 0, 2.1e9, 0.277);
   const index N = g.nodes();
   const real kscale = A.diagonal()[0];
@@ -119,7 +109,7 @@ TEST(ElasticityApply, RigidBodyModesLieInKernelWithoutDirichlet) {
 TEST(ElasticityApply, PatchTestLinearFieldHasZeroInteriorResidual) {
   // u = G x + c is an exact solution of the homogeneous equations: K u vanishes
   // at every node that is not on the boundary of the box.
-  const GridDims g = dims(6, 5, 4);
+  const GridDims g = test::prism(6, 5, 4);
   ElasticityOperator A(g, 0, 2.1e9, 0.277);
   const index N = g.nodes();
   const real G[3][3] = {{0.1, -0.3, 0.2}, {0.05, 0.4, -0.1}, {-0.2, 0.15, 0.3}};
@@ -149,7 +139,7 @@ TEST(ElasticityApply, PatchTestLinearFieldHasZeroInteriorResidual) {
 TEST(ZeroConstrained, ZeroesExactlyTheConstrainedFaces) {
   for (auto& s : kSizes)
     for (unsigned faces : kFaceSets) {
-      const GridDims g = dims(s[0], s[1], s[2]);
+      const GridDims g = test::prism(s[0], s[1], s[2]);
       auto v = random_vector(3 * g.nodes(), 9);
       const auto before = v;
       zero_constrained(g, faces, v.data());
@@ -164,7 +154,7 @@ TEST(ZeroConstrained, ZeroesExactlyTheConstrainedFaces) {
 }
 
 TEST(BottomBlock, OptimisedEqualsReferenceAndAssembly) {
-  const GridDims g = dims(4, 3, 2);
+  const GridDims g = test::prism(4, 3, 2);
   ElasticityOperator A(g, kFaceX0, 1.0, 0.3);
   const index M = g.nx() * g.ny();
   A.set_bottom_block(random_vector(4 * M, 21));

@@ -5,9 +5,22 @@
 #include <cstdint>
 #include <vector>
 
+#include "kernels/grid.hpp"
 #include "kernels/types.hpp"
 
 namespace tresca::test {
+
+// the seed prism's box (2 x 1 x 0.9) with ex x ey x ez bricks
+inline GridDims prism(index ex, index ey, index ez) {
+  GridDims g;
+  g.ex = ex;
+  g.ey = ey;
+  g.ez = ez;
+  g.lx = 2;
+  g.ly = 1;
+  g.lz = 0.9;
+  return g;
+}
 
 inline std::vector<real> random_vector(index n, std::uint64_t seed = 1) {
   std::vector<real> v(n);

@@ -5,6 +5,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "core/cg.hpp"
+#include "core/interior.hpp"
 #include "core/multigrid.hpp"
 #include "core/problem.hpp"
 #include "kernels/vector_ops.hpp"
@@ -20,13 +21,13 @@ TEST(MultigridCG, MatchesSparseDirectSolveOnOddMeshes) {
     mo.coarse_nodes = 60;  // force several levels even on small meshes
     Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
     ASSERT_GE(mg.num_levels(), 2);
-    std::vector<real> b(P.load), u(P.dofs());
-    zero_constrained(P.grid, P.interior_faces, b.data());
-    CGOptions o;
-    o.rtol = 1e-12;
-    CGWorkspace ws;
-    const SolveStats st = pcg(mg.op(0), &mg, b.data(), u.data(), o, ws);
+    const InteriorSolution sol = solve_interior_elasticity(P, mg, 1e-12);
+    const SolveStats& st = sol.stats;
+    const std::vector<real>& u = sol.u;
     ASSERT_TRUE(st.ok()) << to_string(st.reason);
+    EXPECT_LT(sol.relative_residual, 1e-11);
+    std::vector<real> b(P.load);
+    zero_constrained(P.grid, P.interior_faces, b.data());
     EXPECT_LT(st.iterations, 40);
     Eigen::SimplicialLDLT<SparseMatrix> ldlt(assemble(mg.op(0)));
     Eigen::Map<const Eigen::VectorXd> bv(b.data(), P.dofs());
@@ -49,14 +50,10 @@ TEST(MultigridCG, IterationCountIsMeshIndependent) {
     mo.coarse_nodes = 100;
     Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
     ASSERT_GE(mg.num_levels(), 3);
-    std::vector<real> b(P.load), u(P.dofs());
-    zero_constrained(P.grid, P.interior_faces, b.data());
-    CGOptions o;
-    o.rtol = 1e-10;
-    CGWorkspace ws;
-    const SolveStats st = pcg(mg.op(0), &mg, b.data(), u.data(), o, ws);
-    ASSERT_TRUE(st.ok());
-    its[level - 4] = st.iterations;
+    const InteriorSolution sol = solve_interior_elasticity(P, mg, 1e-10);
+    ASSERT_TRUE(sol.stats.ok());
+    EXPECT_LT(sol.relative_residual, 1e-10);
+    its[level - 4] = sol.stats.iterations;
   }
   EXPECT_LE(its[2], its[0] + 3);
   EXPECT_LE(its[1], its[0] + 3);

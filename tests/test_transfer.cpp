@@ -11,22 +11,12 @@ using test::max_abs_diff;
 using test::random_vector;
 
 namespace {
-GridDims box(index ex, index ey, index ez) {
-  GridDims g;
-  g.ex = ex;
-  g.ey = ey;
-  g.ez = ez;
-  g.lx = 2;
-  g.ly = 1;
-  g.lz = 0.9;
-  return g;
-}
 const index kPairs[][6] = {{23, 12, 12, 12, 6, 6}, {7, 3, 5, 4, 2, 3}, {8, 4, 4, 4, 2, 2}, {5, 1, 2, 3, 1, 1}};
 }  // namespace
 
 TEST(Transfer, OptimisedEqualsReferenceOnNonNestedGrids) {
   for (auto& p : kPairs) {
-    const Transfer t = build_transfer(box(p[0], p[1], p[2]), box(p[3], p[4], p[5]));
+    const Transfer t = build_transfer(test::prism(p[0], p[1], p[2]), test::prism(p[3], p[4], p[5]));
     auto c = random_vector(2 * t.coarse.nodes(), 1);
     auto f = random_vector(2 * t.fine.nodes(), 2);
     std::vector<real> pf(f.size()), pfr(f.size()), rc(c.size()), rcr(c.size());
@@ -50,7 +40,7 @@ TEST(Transfer, OptimisedEqualsReferenceOnNonNestedGrids) {
 
 TEST(Transfer, ProlongationReproducesTrilinearFields) {
   for (auto& p : kPairs) {
-    const GridDims F = box(p[0], p[1], p[2]), C = box(p[3], p[4], p[5]);
+    const GridDims F = test::prism(p[0], p[1], p[2]), C = test::prism(p[3], p[4], p[5]);
     const Transfer t = build_transfer(F, C);
     auto field = [](real x, real y, real z) { return 1 + 2 * x - y + 0.5 * z + 0.3 * x * y - 0.7 * y * z + x * y * z; };
     std::vector<real> c(C.nodes()), f(F.nodes());
