@@ -29,17 +29,22 @@ std::uint8_t axis_class(index i, index n, bool c_lo, bool c_hi) {
 bool dropped(std::uint8_t c, int d) { return (d < 0 && (c & kDropL)) || (d > 0 && (c & kDropR)); }
 
 // Accumulates the groups [g, ge) whose nonzero outputs are the mask M.
-template <int W, int M>
-inline void accumulate(const StencilGroup* g, const StencilGroup* ge, const real* x, real* a0, real* a1, real* a2) {
+// V is a vector of kLanes doubles (GCC/Clang vector extension, unaligned
+// loads); each input vector is loaded once and feeds the |M| outputs.
+constexpr int kLanes = 8;
+typedef real V __attribute__((vector_size(kLanes * sizeof(real)), aligned(sizeof(real))));
+
+template <int NV, int M>
+inline void accumulate(const StencilGroup* g, const StencilGroup* ge, const real* x, V* a0, V* a1, V* a2) {
   for (; g != ge; ++g) {
     const real* xp = x + g->off;
     const real c0 = g->c[0], c1 = g->c[1], c2 = g->c[2];
-#pragma omp simd
-    for (int l = 0; l < W; ++l) {
-      const real v = xp[l];
-      if (M & 1) a0[l] += c0 * v;
-      if (M & 2) a1[l] += c1 * v;
-      if (M & 4) a2[l] += c2 * v;
+    V v[NV];
+    for (int l = 0; l < NV; ++l) v[l] = *reinterpret_cast<const V*>(xp + kLanes * l);
+    for (int l = 0; l < NV; ++l) {
+      if (M & 1) a0[l] += c0 * v[l];
+      if (M & 2) a1[l] += c1 * v[l];
+      if (M & 4) a2[l] += c2 * v[l];
     }
   }
 }
@@ -48,28 +53,32 @@ inline void accumulate(const StencilGroup* g, const StencilGroup* ge, const real
 template <int W>
 inline void stencil_block(const StencilGroup* g, const std::int32_t* f, const real* x, real* y, const real* b,
                           index N, index i) {
-  real a0[W], a1[W], a2[W];
-  for (int l = 0; l < W; ++l) a0[l] = a1[l] = a2[l] = 0;
-  x += i;
-  accumulate<W, 1>(g + f[0], g + f[1], x, a0, a1, a2);
-  accumulate<W, 2>(g + f[1], g + f[2], x, a0, a1, a2);
-  accumulate<W, 3>(g + f[2], g + f[3], x, a0, a1, a2);
-  accumulate<W, 4>(g + f[3], g + f[4], x, a0, a1, a2);
-  accumulate<W, 5>(g + f[4], g + f[5], x, a0, a1, a2);
-  accumulate<W, 6>(g + f[5], g + f[6], x, a0, a1, a2);
-  accumulate<W, 7>(g + f[6], g + f[7], x, a0, a1, a2);
-  if (b) {
+  if constexpr (W % kLanes != 0) {
+    // scalar path for runs shorter than one vector
     for (int l = 0; l < W; ++l) {
-      y[i + l] = b[i + l] - a0[l];
-      y[N + i + l] = b[N + i + l] - a1[l];
-      y[2 * N + i + l] = b[2 * N + i + l] - a2[l];
+      real acc[3] = {0, 0, 0};
+      for (const StencilGroup* q = g + f[0]; q != g + f[7]; ++q)
+        for (int a = 0; a < 3; ++a) acc[a] += q->c[a] * x[i + l + q->off];
+      for (int a = 0; a < 3; ++a) y[a * N + i + l] = b ? b[a * N + i + l] - acc[a] : acc[a];
     }
   } else {
-    for (int l = 0; l < W; ++l) {
-      y[i + l] = a0[l];
-      y[N + i + l] = a1[l];
-      y[2 * N + i + l] = a2[l];
-    }
+    constexpr int NV = W / kLanes;
+    V a0[NV], a1[NV], a2[NV];
+    for (int l = 0; l < NV; ++l) a0[l] = a1[l] = a2[l] = V{};
+    x += i;
+    accumulate<NV, 1>(g + f[0], g + f[1], x, a0, a1, a2);
+    accumulate<NV, 2>(g + f[1], g + f[2], x, a0, a1, a2);
+    accumulate<NV, 3>(g + f[2], g + f[3], x, a0, a1, a2);
+    accumulate<NV, 4>(g + f[3], g + f[4], x, a0, a1, a2);
+    accumulate<NV, 5>(g + f[4], g + f[5], x, a0, a1, a2);
+    accumulate<NV, 6>(g + f[5], g + f[6], x, a0, a1, a2);
+    accumulate<NV, 7>(g + f[6], g + f[7], x, a0, a1, a2);
+    V* out[3] = {a0, a1, a2};
+    for (int a = 0; a < 3; ++a)
+      for (int l = 0; l < NV; ++l) {
+        V* yp = reinterpret_cast<V*>(y + a * N + i + kLanes * l);
+        *yp = b ? *reinterpret_cast<const V*>(b + a * N + i + kLanes * l) - out[a][l] : out[a][l];
+      }
   }
 }
 
