@@ -95,28 +95,35 @@ void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine
 }
 
 void restrict_to_coarse(const Transfer& t, int comps, const real* fine, real* coarse) {
+  // Per coarse row (jy, jz): sum the weighted fine rows of its y/z support
+  // into one row buffer (contiguous, vectorisable), then gather along x.
   const GridDims &f = t.fine, &c = t.coarse;
-  const index Nf = f.nodes(), Nc = c.nodes();
+  const index Nf = f.nodes(), Nc = c.nodes(), fnx = f.nx();
   const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
-#pragma omp parallel for collapse(2) schedule(static)
-  for (index jz = 0; jz < c.nz(); ++jz)
-    for (index jy = 0; jy < c.ny(); ++jy)
-      for (int a = 0; a < comps; ++a) {
-        const real* r = fine + a * Nf;
-        real* out = coarse + a * Nc + c.nx() * (jy + c.ny() * jz);
-        for (index jx = 0; jx < c.nx(); ++jx) {
-          real s = 0;
+#pragma omp parallel
+  {
+    std::vector<real> row(fnx);  // one buffer per thread, allocated once per call
+#pragma omp for collapse(2) schedule(static)
+    for (index jz = 0; jz < c.nz(); ++jz)
+      for (index jy = 0; jy < c.ny(); ++jy)
+        for (int a = 0; a < comps; ++a) {
+          real* acc = row.data();
+          for (index i = 0; i < fnx; ++i) acc[i] = 0;
           for (index kz = Z.tstart[jz]; kz < Z.tstart[jz + 1]; ++kz)
             for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky) {
-              const real wyz = Z.tw[kz] * Y.tw[ky];
-              const real* rr = r + f.nx() * (Y.tf[ky] + f.ny() * Z.tf[kz]);
-              real sx = 0;
-              for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += X.tw[kx] * rr[X.tf[kx]];
-              s += wyz * sx;
+              const real w = Z.tw[kz] * Y.tw[ky];
+              const real* rr = fine + a * Nf + fnx * (Y.tf[ky] + f.ny() * Z.tf[kz]);
+#pragma omp simd
+              for (index i = 0; i < fnx; ++i) acc[i] += w * rr[i];
             }
-          out[jx] = s;
+          real* out = coarse + a * Nc + c.nx() * (jy + c.ny() * jz);
+          for (index jx = 0; jx < c.nx(); ++jx) {
+            real sx = 0;
+            for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += X.tw[kx] * acc[X.tf[kx]];
+            out[jx] = sx;
+          }
         }
-      }
+  }
 }
 
 void restrict_to_coarse_ref(const Transfer& t, int comps, const real* fine, real* coarse) {

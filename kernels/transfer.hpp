@@ -6,10 +6,11 @@
 //
 // P is a tensor product P = Pz ⊗ Py ⊗ Px of 1D interpolations, each row with
 // at most two nonzeros. The optimised kernels are gathers (race-free, OpenMP
-// over output rows): prolongation reads 8 coarse values per fine node,
-// restriction reads the fine nodes in the support of each coarse hat function
-// (1D transposed lists). The _ref twins are the literal serial loops
-// (restriction as a scatter of P^T).
+// over output rows): prolongation reads 8 coarse values per fine node;
+// restriction sums, per coarse row, the weighted fine rows of its y/z support
+// into a row buffer (vectorised) and then gathers along x with the 1D
+// transposed lists. The _ref twins are the literal serial loops (restriction
+// as a scatter of P^T).
 //
 // DATA LAYOUT: SoA fields as in grid.hpp; `comps` components of size N each.
 // Cost per fine dof: prolongation 8 reads + 1 write; restriction about the same
