@@ -48,6 +48,43 @@ class ReducedNewtonOperator : public LinearOperator {
   const std::vector<std::uint8_t>& free_;
 };
 
+// The reduced Newton system of one step (method.md §4).
+struct ReducedSystem {
+  explicit ReducedSystem(index n3) : known(n3), h(n3), rhs(n3), fixed(n3), free(n3) {}
+  std::vector<real> known;  // known increments: Δu_τ = v_12 (sticking), Δu_z = v_4 (contact)
+  std::vector<real> h;      // H_1 blocks (h11 | h12 | h22) of sliding nodes
+  std::vector<real> rhs;    // r_F: (I + H_1) v_12 on sliding rows, v_3 + v_4 on separated u_z rows
+  std::vector<std::uint8_t> fixed, free;  // per dof: increment known / part of F
+};
+
+// Fills L from the node status and the approximation step (v, d); returns
+// whether any known increment is nonzero.
+bool linearise(index p, real phi, const std::vector<std::uint8_t>& status, const std::vector<real>& v,
+               const std::vector<real>& d, ReducedSystem& L) {
+  bool any_known = false;
+  for (index i = 0; i < p; ++i) {
+    const bool stick = status[i] & kStick, contact = status[i] & kContact;
+    const real v1 = v[i], v2 = v[p + i], v3 = v[2 * p + i], v4 = v[3 * p + i];
+    L.fixed[i] = L.fixed[p + i] = stick;
+    L.fixed[2 * p + i] = contact;
+    L.free[i] = L.free[p + i] = !stick;
+    L.free[2 * p + i] = !contact;
+    real h11 = 0, h12 = 0, h22 = 0;
+    if (!stick) sliding_block(phi, d[i], d[p + i], h11, h12, h22);
+    L.h[i] = h11;
+    L.h[p + i] = h12;
+    L.h[2 * p + i] = h22;
+    L.known[i] = stick ? v1 : 0;
+    L.known[p + i] = stick ? v2 : 0;
+    L.known[2 * p + i] = contact ? v4 : 0;
+    L.rhs[i] = stick ? 0 : v1 + h11 * v1 + h12 * v2;
+    L.rhs[p + i] = stick ? 0 : v2 + h12 * v1 + h22 * v2;
+    L.rhs[2 * p + i] = contact ? 0 : v3 + v4;
+    any_known = any_known || L.known[i] != 0 || L.known[p + i] != 0 || L.known[2 * p + i] != 0;
+  }
+  return any_known;
+}
+
 }  // namespace
 
 NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, real phi,
@@ -68,10 +105,11 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     S.apply(R.u.data(), R.Su.data());
     S.set_inner_rtol(keep);
   }
-  std::vector<real> r(n3), v(4 * p), d(3 * p), h(n3), rhs(n3), du(n3), dknown(n3), Sdu(n3);
-  std::vector<std::uint8_t> fixed(n3), free(n3);
+  std::vector<real> r(n3), v(4 * p), d(3 * p), du(n3), Sdu(n3);
+  ReducedSystem L(n3);
+  std::vector<real>& rhs = L.rhs;
   BoundaryPreconditioner M(S);
-  ReducedNewtonOperator A(S, h, free);
+  ReducedNewtonOperator A(S, L.h, L.free);
   CGWorkspace ws;
   real best = INFINITY;
   int since_best = 0;
@@ -116,37 +154,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     }
 
     // Newton step: known increments, free set, H, right-hand side
-    std::fill(dknown.begin(), dknown.end(), 0.0);
-    std::fill(h.begin(), h.end(), 0.0);
-    bool any_known = false;
-    for (index i = 0; i < p; ++i) {
-      const bool stick = R.status[i] & kStick, contact = R.status[i] & kContact;
-      const real v1 = v[i], v2 = v[p + i], v3 = v[2 * p + i], v4 = v[3 * p + i];
-      fixed[i] = fixed[p + i] = stick;
-      fixed[2 * p + i] = contact;
-      free[i] = free[p + i] = !stick;
-      free[2 * p + i] = !contact;
-      if (stick) {
-        dknown[i] = v1;
-        dknown[p + i] = v2;
-        rhs[i] = rhs[p + i] = 0;
-      } else {
-        real h11, h12, h22;
-        sliding_block(phi, d[i], d[p + i], h11, h12, h22);
-        h[i] = h11;
-        h[p + i] = h12;
-        h[2 * p + i] = h22;
-        rhs[i] = v1 + h11 * v1 + h12 * v2;
-        rhs[p + i] = v2 + h12 * v1 + h22 * v2;
-      }
-      if (contact) {
-        dknown[2 * p + i] = v4;
-        rhs[2 * p + i] = 0;
-      } else {
-        rhs[2 * p + i] = v3 + v4;
-      }
-      any_known = any_known || dknown[i] != 0 || dknown[p + i] != 0 || dknown[2 * p + i] != 0;
-    }
+    const bool any_known = linearise(p, phi, R.status, v, d, L);
     // Accuracy of the step, absolute: decisions compare forces with phi and
     // u_z, so early steps must be near-exact (1e-10 |v0|); late steps need
     // only a fraction of |v_k|; nothing below 0.1 eps is useful.
@@ -154,14 +162,14 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     const long long fails0 = S.stats().failures;
     if (any_known) {
       S.set_inner_rtol(1e-12);
-      S.apply(dknown.data(), Sdu.data());
+      S.apply(L.known.data(), Sdu.data());
       R.operator_applications += 1;
       for (index i = 0; i < n3; ++i)
-        if (free[i]) rhs[i] -= Sdu[i];
+        if (L.free[i]) rhs[i] -= Sdu[i];
     } else {
       std::fill(Sdu.begin(), Sdu.end(), 0.0);
     }
-    M.update(h, fixed, free);
+    M.update(L.h, L.fixed, L.free);
     CGOptions co;
     co.rtol = 1e-13;  // attainable floor relative to |rhs|
     co.atol = target;
@@ -177,6 +185,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     }
     R.outer_iterations += st.iterations;
     R.operator_applications += st.iterations;
+    if (st.reason == SolveReason::max_iterations) R.outer_limit_hits += 1;  // inexact step taken
     if (S.stats().failures > fails0) {
       R.reason = NewtonReason::inner_failure;
       break;
@@ -186,7 +195,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
       break;
     }
     // update x and S u
-    for (index i = 0; i < n3; ++i) du[i] += dknown[i];
+    for (index i = 0; i < n3; ++i) du[i] += L.known[i];
     for (index i = 0; i < p; ++i)
       R.lambda[i] += (R.status[i] & kContact) ? Sdu[2 * p + i] - v[2 * p + i] : v[3 * p + i];
     axpy(n3, 1, du.data(), R.u.data());

@@ -61,6 +61,7 @@ struct NewtonResult {
   std::vector<real> u, lambda, Su;     // 3p, p, 3p
   std::vector<std::uint8_t> status;    // per node: kContact | kStick at the last approximation step
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
+  int outer_limit_hits = 0;  // Newton steps whose outer CG stopped at its iteration limit
   bool converged() const { return reason == NewtonReason::converged; }
 };
 

@@ -62,6 +62,7 @@ std::string summary_json(const ProblemSpec& spec, const RunResult& R, int thread
   counts.integer("inner_iterations", R.inner_iterations).integer("outer_iterations", N.outer_iterations)
       .integer("operator_applications", N.operator_applications)
       .integer("newton_inner_iterations", N.inner_iterations)
+      .integer("outer_limit_hits", N.outer_limit_hits)
       .num("fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step());
   contact.integer("active", F.active).integer("separated", F.separated).integer("sticking", F.sticking)
       .integer("sliding", F.sliding).num("ux_min", F.ux_min).num("uz_max", F.uz_max).num("lambda_sum", F.lambda_sum);
@@ -189,6 +190,9 @@ int main(int argc, char** argv) {
                 F.uz_max, F.lambda_sum);
     std::printf("work: %lld inner CG iterations, %lld outer CG iterations, %lld S applications\n", R.inner_iterations,
                 N.outer_iterations, N.operator_applications);
+    if (N.outer_limit_hits > 0)
+      std::printf("note: %d Newton steps were taken with an outer CG stopped at its iteration limit\n",
+                  N.outer_limit_hits);
     std::printf("work: %.1f fine-grid matvec equivalents per Newton step; peak memory %.2f GB\n",
                 R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9);
     std::printf("times [s]: setup %.3f, condense %.3f, solve %.3f, recover %.3f, total %.3f\n", R.times.setup,

@@ -202,6 +202,34 @@ TEST(SemismoothNewton, ReportsIterationLimitHonestly) {
   EXPECT_GT(R.newton.history.back(), 1e-6);
 }
 
+TEST(SemismoothNewton, ReportsStagnationForUnattainableTolerance) {
+  ProblemSpec spec = spec_for_dims(8, 4, 4);
+  RunOptions o;
+  o.newton.eps = 1e-20;  // far below double-precision round-off of forces ~1e7 N
+  o.newton.max_iterations = 100;
+  o.recover_interior = false;
+  const RunResult R = run_tresca(spec, o);
+  EXPECT_FALSE(R.newton.converged());
+  EXPECT_EQ(R.newton.reason, NewtonReason::stagnation);
+  EXPECT_LT(R.newton.iterations, 40);
+  EXPECT_LT(R.report.true_residual_relative, 1e-12);  // the solution itself is fine
+}
+
+TEST(BoundaryPreconditioner, KeepsOuterIterationsFlatUnderRefinement) {
+  double per_step[3];
+  const int levels[3] = {4, 6, 7};
+  for (int k = 0; k < 3; ++k) {
+    RunOptions o;
+    o.recover_interior = false;
+    const RunResult R = run_tresca(spec_for_level(levels[k]), o);
+    ASSERT_TRUE(R.newton.converged());
+    EXPECT_EQ(R.newton.outer_limit_hits, 0);
+    per_step[k] = double(R.newton.outer_iterations) / R.newton.iterations;
+    EXPECT_LT(per_step[k], 6.0) << "level " << levels[k];
+  }
+  EXPECT_LE(per_step[2], per_step[0] + 1.0);
+}
+
 TEST(Problem, MeshSizesMatchPaperTable1) {
   const long long n[] = {225, 637, 1377, 4056, 9537, 27072, 70785};
   const long long p[] = {40, 84, 144, 299, 544, 1104, 2112};
