@@ -11,11 +11,21 @@
 namespace tresca {
 
 namespace {
+// Semi-coarsening: halve (rounding up) only the axes whose spacing is within
+// 1.5x of the finest one, so that anisotropic bricks become isotropic on the
+// coarse grids instead of flatter. Near-isotropic grids coarsen in all axes.
 GridDims coarsen(const GridDims& g) {
+  index* e[3] = {nullptr, nullptr, nullptr};
   GridDims c = g;
-  c.ex = (g.ex + 1) / 2;
-  c.ey = (g.ey + 1) / 2;
-  c.ez = (g.ez + 1) / 2;
+  e[0] = &c.ex;
+  e[1] = &c.ey;
+  e[2] = &c.ez;
+  const real h[3] = {g.hx(), g.hy(), g.hz()};
+  real hmin = INFINITY;
+  for (int a = 0; a < 3; ++a)
+    if (*e[a] > 1) hmin = std::min(hmin, h[a]);
+  for (int a = 0; a < 3; ++a)
+    if (*e[a] > 1 && h[a] <= 1.5 * hmin) *e[a] = (*e[a] + 1) / 2;
   return c;
 }
 }  // namespace

@@ -1,9 +1,11 @@
 // Geometric multigrid V-cycle for the Q1 elasticity operator on the brick grid,
 // used as a preconditioner (one V-cycle with zero initial guess per apply).
 //
-// Hierarchy: each coarser grid has ceil(e/2) elements per axis (non-nested
-// when e is odd), the same box and constrained faces, and is rediscretised
-// (same brick formula, coarse h). Transfers are trilinear interpolation and
+// Hierarchy: each coarser grid has ceil(e/2) elements along every axis whose
+// spacing is within 1.5x of the finest (semi-coarsening for anisotropic
+// bricks; all axes on the benchmark's near-cubic bricks), non-nested when e is
+// odd, the same box and constrained faces, and is rediscretised (same brick
+// formula, coarse h). Transfers are trilinear interpolation and
 // its exact transpose (kernels/transfer.hpp). Coarsening stops when a grid has
 // at most `coarse_nodes` nodes; that grid is solved directly (Eigen sparse
 // LDLT of the assembled matrix, factorised once).

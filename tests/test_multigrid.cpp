@@ -60,6 +60,19 @@ TEST(MultigridCG, IterationCountIsMeshIndependent) {
   EXPECT_LT(its[2], 20);
 }
 
+TEST(MultigridCG, SemiCoarseningKeepsAnisotropicMeshesFast) {
+  // full coarsening of flat or elongated bricks needed 200-330 iterations here
+  const index sizes[][3] = {{256, 2, 2}, {8, 8, 200}, {200, 100, 2}};
+  for (auto& s : sizes) {
+    const Problem P = make_problem(spec_for_dims(s[0], s[1], s[2]));
+    Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+    const InteriorSolution sol = solve_interior_elasticity(P, mg, 1e-10);
+    ASSERT_TRUE(sol.stats.ok());
+    EXPECT_LT(sol.stats.iterations, 15) << s[0] << "x" << s[1] << "x" << s[2] << ": " << mg.describe();
+    EXPECT_LT(sol.relative_residual, 1e-10);
+  }
+}
+
 TEST(CG, ReportsMaxIterationsInsteadOfLooping) {
   const Problem P = make_problem(spec_for_level(4));
   ElasticityOperator A(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
