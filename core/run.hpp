@@ -3,6 +3,7 @@
 // (b̃ = condensed load), solve (semismooth* Newton), recover (final check
 // with a tight S apply + interior displacement).
 #pragma once
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -13,6 +14,8 @@ namespace tresca {
 
 struct RunOptions {
   NewtonOptions newton;
+  // called after each phase with its name and duration (progress on long runs)
+  std::function<void(const char* phase, double seconds)> phase_done;
   bool recover_interior = true;  // full 3D displacement (needed for VTK output)
   real tight_rtol = 1e-12;
 };

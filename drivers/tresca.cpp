@@ -129,6 +129,11 @@ int main(int argc, char** argv) {
 
   try {
     if (!quiet)
+      opt.phase_done = [](const char* phase, double sec) {
+        std::printf("  %s: %.2f s\n", phase, sec);
+        std::fflush(stdout);
+      };
+    if (!quiet)
       opt.newton.progress = [](const NewtonProgress& p) {
         std::printf("  it %2d  |v| %10.3e  contact %7lld  separated %7lld  stick %7lld  slip %7lld  inner %7lld  outer %5lld  %8.2f s\n",
                     p.iteration, p.residual, (long long)p.active, (long long)p.separated, (long long)p.sticking,
@@ -149,6 +154,7 @@ int main(int argc, char** argv) {
         s.nu = spec.nu;
         RunOptions o = opt;
         o.newton.progress = nullptr;
+        o.phase_done = nullptr;
         o.recover_interior = false;
         const RunResult R = run_tresca(s, o);
         const PaperRow* pr = paper_row(L);
