@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "../kernels/contact_maps.hpp"
 #include "../kernels/vector_ops.hpp"
@@ -108,7 +109,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   std::vector<real> r(n3), v(4 * p), d(3 * p), du(n3), Sdu(n3);
   ReducedSystem L(n3);
   std::vector<real>& rhs = L.rhs;
-  BoundaryPreconditioner M(S);
+  std::unique_ptr<BoundaryPreconditioner> M;
+  if (opt.outer_pc == OuterPreconditioner::multigrid) M = std::make_unique<BoundaryPreconditioner>(S);
   ReducedNewtonOperator A(S, L.h, L.free);
   CGWorkspace ws;
   real best = INFINITY;
@@ -169,11 +171,11 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     } else {
       std::fill(Sdu.begin(), Sdu.end(), 0.0);
     }
-    M.update(L.h, L.fixed, L.free);
+    if (M) M->update(L.h, L.fixed, L.free);
     CGOptions co;
     co.rtol = 1e-13;  // attainable floor relative to |rhs|
     co.atol = target;
-    co.max_iterations = 200;
+    co.max_iterations = M ? 200 : 5000;
     co.on_step = [&](real alpha) { axpy(n3, alpha, A.Sx.data(), Sdu.data()); };
     // relaxed inner accuracy (Simoncini–Szyld): the perturbation of S may grow
     // like target/|r_j| as the outer residual r_j falls
@@ -181,7 +183,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     SolveStats st;
     {
       ScopedTimer t(Kernel::outer_cg);
-      st = pcg(A, &M, rhs.data(), du.data(), co, ws);
+      st = pcg(A, M.get(), rhs.data(), du.data(), co, ws);
     }
     R.outer_iterations += st.iterations;
     R.operator_applications += st.iterations;

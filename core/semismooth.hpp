@@ -42,8 +42,13 @@ struct NewtonProgress {
   double elapsed;
 };
 
+enum class OuterPreconditioner { multigrid, none };
+
 struct NewtonOptions {
   real eps = 1e-6;
+  // preconditioner of the reduced boundary system: one V-cycle of K + B
+  // (boundary_preconditioner.hpp), or none (plain CG, for comparison)
+  OuterPreconditioner outer_pc = OuterPreconditioner::multigrid;
   int max_iterations = 50;
   real step_accuracy = 1e-3;  // late steps are solved to this fraction of ||v̂_k||
   int stagnation_window = 8;  // stop if ||v̂|| has not decreased over this many steps

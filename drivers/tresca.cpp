@@ -23,6 +23,7 @@ const char* kHelp =
     "  --eps E            stopping tolerance on ||v|| (default 1e-6, absolute)\n"
     "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
     "  --max-newton N     Newton iteration limit (default 50)\n"
+    "  --outer-pc mg|none preconditioner of the boundary Newton system (default mg)\n"
     "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
     "  --json FILE        write the run summary as one JSON object (rows with --table)\n"
     "  --contact-csv FILE one row per contact node\n"
@@ -96,7 +97,7 @@ int main(int argc, char** argv) {
   try {
     const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table"},
+                   "--contact-csv", "--vtk", "--table", "--outer-pc"},
                   {"--quiet", "--help", "--profile"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
@@ -112,6 +113,9 @@ int main(int argc, char** argv) {
     const long long mn = a.int_value("--max-newton", 50);
     if (mn < 0 || mn > 100000) throw std::invalid_argument("--max-newton " + a.str("--max-newton") + " must be in 0..100000");
     opt.newton.max_iterations = int(mn);
+    const std::string pc = a.str("--outer-pc", "mg");
+    if (pc != "mg" && pc != "none") throw std::invalid_argument("--outer-pc '" + pc + "' must be mg or none");
+    opt.newton.outer_pc = pc == "mg" ? OuterPreconditioner::multigrid : OuterPreconditioner::none;
     quiet = a.has("--quiet");
     profile = a.has("--profile");
     json_path = a.str("--json");

@@ -76,6 +76,7 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --dims 4x2x2 --threads 0", "--threads 0");
   expect_error("tresca --table 3-1", "3-1");
   expect_error("tresca --level", "--level");
+  expect_error("tresca --dims 4x2x2 --outer-pc ilu", "ilu");
 }
 
 TEST(TrescaDriver, ReportsNonConvergenceInOutputAndExitStatus) {
