@@ -1,11 +1,11 @@
 #include "elasticity.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 
 #include "element.hpp"
-
-#include <omp.h>
 
 namespace tresca {
 namespace {
@@ -23,16 +23,16 @@ std::uint8_t axis_class(index i, index n, bool c_lo, bool c_hi) {
   return c;
 }
 
-// Coupling of offset d in {-1,0,1} for a node of class c along one axis:
-// which element sides (0 = left element, node is its local 1; 1 = right
-// element, node is its local 0) contribute, and whether the neighbour is dropped.
+// Is the neighbour at offset d in {-1, 0, 1} along one axis a constrained
+// node (its coupling is dropped) for a node of class c?
 bool dropped(std::uint8_t c, int d) { return (d < 0 && (c & kDropL)) || (d > 0 && (c & kDropR)); }
 
 // Accumulates the groups [g, ge) whose nonzero outputs are the mask M.
-// V is a vector of kLanes doubles (GCC/Clang vector extension, unaligned
-// loads); each input vector is loaded once and feeds the |M| outputs.
+// V is a vector of kLanes doubles (GCC/Clang vector extension; unaligned,
+// and may_alias because it reads and writes plain double arrays); each input
+// vector is loaded once and feeds the |M| outputs.
 constexpr int kLanes = 8;
-typedef real V __attribute__((vector_size(kLanes * sizeof(real)), aligned(sizeof(real))));
+typedef real V __attribute__((vector_size(kLanes * sizeof(real)), aligned(sizeof(real)), may_alias));
 
 template <int NV, int M>
 inline void accumulate(const StencilGroup* g, const StencilGroup* ge, const real* x, V* a0, V* a1, V* a2) {
@@ -87,10 +87,10 @@ inline void stencil_range(const StencilGroup* g, const std::int32_t* f, const re
   constexpr int kW = 16;
   index i = i0;
   for (; i + kW <= i1; i += kW) stencil_block<kW>(g, f, x, y, b, N, i);
-  for (; i + 8 <= i1; i += 8) stencil_block<8>(g, f, x, y, b, N, i);
-  if (i < i1 && i1 - i0 >= 8) {
-    // finish with one overlapping block: recomputes a few outputs of the same run
-    stencil_block<8>(g, f, x, y, b, N, i1 - 8);
+  for (; i + kLanes <= i1; i += kLanes) stencil_block<kLanes>(g, f, x, y, b, N, i);
+  if (i < i1 && i1 - i0 >= kLanes) {
+    // finish with one overlapping vector: recomputes a few outputs of the same run
+    stencil_block<kLanes>(g, f, x, y, b, N, i1 - kLanes);
     return;
   }
   for (; i < i1; ++i) stencil_block<1>(g, f, x, y, b, N, i);
