@@ -40,8 +40,8 @@ void BoundaryPreconditioner::update(const std::vector<real>& h, const std::vecto
 }
 
 void BoundaryPreconditioner::apply(const real* r, real* z) const {
-  const index n = index(full_in_.size());
-  fill(n, 0, full_in_.data());
+  // full_in_ is zero off the contact nodes (set once; the scatter writes only
+  // contact nodes and the V-cycle never writes its right-hand side)
   S_.scatter(r, full_in_.data());
   mg_.apply(full_in_.data(), full_out_.data());
   S_.gather(full_out_.data(), z);
