@@ -1,6 +1,5 @@
 #include "boundary_preconditioner.hpp"
 
-#include "../kernels/vector_ops.hpp"
 
 namespace tresca {
 
