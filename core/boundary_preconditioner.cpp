@@ -1,6 +1,5 @@
 #include "boundary_preconditioner.hpp"
 
-
 namespace tresca {
 
 namespace {
