@@ -13,6 +13,7 @@ const char* to_string(SolveReason r) {
     case SolveReason::max_iterations: return "max_iterations";
     case SolveReason::breakdown: return "breakdown";
     case SolveReason::non_finite: return "non_finite";
+    case SolveReason::aborted: return "aborted";
   }
   return "?";
 }
@@ -59,6 +60,10 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
       return st;
     }
     A.apply(p, q);
+    if (opt.abort_if && opt.abort_if()) {
+      st.reason = SolveReason::aborted;
+      return st;
+    }
     real pq;
     {
       ScopedTimer t(Kernel::vector, 16.0 * n, 2.0 * n);

@@ -2,8 +2,10 @@
 //
 // Stops when ||r|| <= max(rtol*||b||, atol) (Euclidean norm of the true
 // recursive residual), or returns the reason it could not: max_iterations,
-// breakdown (p.Ap <= 0 or r.z <= 0: operator or preconditioner not SPD), or
-// non_finite (NaN/Inf appeared). It never loops beyond max_iterations.
+// breakdown (p.Ap <= 0 or r.z <= 0: operator or preconditioner not SPD),
+// non_finite (NaN/Inf appeared), or aborted (the caller's abort_if said so,
+// e.g. an inexactly applied operator failed). It never loops beyond
+// max_iterations.
 //
 // Per iteration: 1 apply of A, 1 of M, 2 dots + 1 fused update + 1 xpay:
 // vector traffic about 112 bytes and 14 flops per entry besides A and M.
@@ -16,7 +18,7 @@
 
 namespace tresca {
 
-enum class SolveReason { converged, max_iterations, breakdown, non_finite };
+enum class SolveReason { converged, max_iterations, breakdown, non_finite, aborted };
 const char* to_string(SolveReason r);
 
 struct SolveStats {
@@ -39,6 +41,8 @@ struct CGOptions {
   // called with ||r|| of the initial residual and after every update (lets an
   // inexactly applied A relax its accuracy as the residual falls)
   std::function<void(real rnorm)> on_residual;
+  // checked after every application of A; true stops with reason aborted
+  std::function<bool()> abort_if;
 };
 
 // Work vectors kept by the caller so repeated solves do not allocate.

@@ -15,7 +15,16 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   const double t2 = wall_time();
   if (opt.phase_done) opt.phase_done("condensed load", t2 - t1);
   const double apply_nodes0 = profile_get(Kernel::apply).items;
-  R.newton = semismooth_newton(S, btilde, spec.phi, opt.newton);
+  if (S.stats().failures > 0) {
+    // b̃ is untrustworthy: report instead of iterating on a wrong problem
+    const index p = R.problem->contact_nodes();
+    R.newton.reason = NewtonReason::inner_failure;
+    R.newton.u.assign(3 * p, 0);
+    R.newton.lambda.assign(p, 0);
+    R.newton.status.assign(p, 0);
+  } else {
+    R.newton = semismooth_newton(S, btilde, spec.phi, opt.newton);
+  }
   const double t3 = wall_time();
   R.fine_matvecs_solve = (profile_get(Kernel::apply).items - apply_nodes0) / double(R.problem->nodes());
   if (opt.phase_done) opt.phase_done("semismooth* Newton", t3 - t2);

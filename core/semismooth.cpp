@@ -180,6 +180,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     // relaxed inner accuracy (Simoncini–Szyld): the perturbation of S may grow
     // like target/|r_j| as the outer residual r_j falls
     co.on_residual = [&](real rn) { S.set_inner_rtol(std::clamp(0.1 * target / rn, 1e-12, 1e-2)); };
+    co.abort_if = [&] { return S.stats().failures > fails0; };  // an S apply is untrustworthy
     SolveStats st;
     {
       ScopedTimer t(Kernel::outer_cg);

@@ -1,6 +1,7 @@
 // tresca: 3D linear-elastic contact with Tresca friction by the semismooth*
 // Newton method, matrix-free on the contact boundary. See --help.
 // Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure.
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <stdexcept>
@@ -79,7 +80,7 @@ std::string summary_json(const ProblemSpec& spec, const RunResult& R, int thread
       .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
       .num("phi", spec.phi).num("eps", eps).integer("threads", threads).integer("newton_iterations", N.iterations)
       .boolean("converged", N.converged()).str("reason", to_string(N.reason))
-      .array("residual_history", N.history).num("final_residual", N.history.empty() ? 0 : N.history.back())
+      .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())
       .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
       .raw("times", times.render()).raw("counts", counts.render()).raw("contact", contact.render())
       .raw("kkt", kkt.render()).num("peak_memory_bytes", R.peak_memory);
@@ -131,6 +132,11 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  if (spec.nu > 0.49)
+    std::fprintf(stderr,
+                 "tresca: warning: nu = %g is nearly incompressible: Q1 elements lock and the multigrid inner solver "
+                 "degrades (it may fail to converge)\n",
+                 spec.nu);
   try {
     if (!quiet)
       opt.phase_done = [](const char* phase, double sec) {
@@ -183,13 +189,16 @@ int main(int argc, char** argv) {
                   (long long)P0.nodes(), (long long)P0.contact_nodes(), (long long)P0.free_dofs(), spec.phi,
                   opt.newton.eps, threads);
       std::printf("        estimated peak memory %.2f GB\n", estimated_memory_bytes(spec) / 1e9);
+
     }
     const RunResult R = run_tresca(spec, opt);
     const NewtonResult& N = R.newton;
     const FinalReport& F = R.report;
-    std::printf("%s after %d Newton iterations (reason: %s), final |v| %.3e (eps %.1e)\n",
-                N.converged() ? "converged" : "NOT CONVERGED", N.iterations, to_string(N.reason),
-                N.history.empty() ? 0.0 : N.history.back(), opt.newton.eps);
+    char last[64] = "n/a (no approximation step)";
+    if (!N.history.empty()) std::snprintf(last, sizeof last, "%.3e", N.history.back());
+    std::printf("%s after %d Newton iterations (reason: %s), final |v| %s (eps %.1e)\n",
+                N.converged() ? "converged" : "NOT CONVERGED", N.iterations, to_string(N.reason), last,
+                opt.newton.eps);
     std::printf("true residual (fresh S u): %.3e absolute, %.3e relative to |b| = %.3e\n", F.true_residual,
                 F.true_residual_relative, F.btilde_norm);
     std::printf("KKT: equilibrium %.2e N, uz<0 %.2e m, lambda<0 %.2e N, lambda*uz %.2e Nm, |r_t|-phi %.2e N, direction %.2e N, stick slip %.2e m\n",

@@ -86,6 +86,16 @@ TEST(TrescaDriver, ReportsNonConvergenceInOutputAndExitStatus) {
   EXPECT_NE(r.out.find("iteration_limit"), std::string::npos) << r.out;
 }
 
+TEST(TrescaDriver, NearlyIncompressibleMaterialFailsFastAndSaysWhy) {
+  // Q1 locks at nu -> 0.5 and the inner multigrid CG cannot converge: the run
+  // must stop at the first failed inner solve with the reason, not hang
+  const CmdResult r = run("tresca --dims 16x8x8 --nu 0.49999 --quiet");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("nearly incompressible"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("inner_solver_failure"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("after 0 Newton iterations"), std::string::npos) << r.out;
+}
+
 TEST(TrescaDriver, WritesJsonCsvAndVtk) {
   const std::string dir = std::string(TRESCA_BIN_DIR) + "/../";
   const std::string json = dir + "t_out.json", csv = dir + "t_out.csv", vtu = dir + "t_out.vtu";
