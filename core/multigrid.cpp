@@ -43,22 +43,27 @@ Multigrid::Multigrid(const GridDims& fine, unsigned faces, real E, real nu, cons
     lv.r.resize(n);
     lv.d.resize(n);
     const bool last = g.nodes() <= opt.coarse_nodes || (g.ex == 1 && g.ey == 1 && g.ez == 1);
-    if (!last) lv.to_coarse = build_transfer(g, coarsen(g));
+    const GridDims coarse = last ? g : coarsen(g);
+    if (!last) lv.to_coarse = build_transfer(g, coarse);
     levels_.push_back(std::move(lv));
     if (levels_.size() > 1) {
       levels_.back().xp = levels_.back().x.data();
       levels_.back().bp = levels_.back().b.data();
     }
     if (last) break;
-    g = coarsen(g);
+    g = coarse;
   }
+  refresh_diagonals();
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) estimate_lmax(levels_[l]);
+  factor_coarse();
+}
+
+void Multigrid::refresh_diagonals() {
   for (auto& lv : levels_) {
-    auto d = lv.A.diagonal();
+    const std::vector<real> d = lv.A.diagonal();
     lv.dinv.resize(d.size());
     for (size_t i = 0; i < d.size(); ++i) lv.dinv[i] = 1 / d[i];
-    if (&lv != &levels_.back()) estimate_lmax(lv);
   }
-  factor_coarse();
 }
 
 void Multigrid::estimate_lmax(Level& lv) {
@@ -131,10 +136,7 @@ void Multigrid::set_bottom_block(const std::vector<real>& B) {
         }
     c.A.set_bottom_block(std::move(Bc));
   }
-  for (auto& lv : levels_) {
-    auto d = lv.A.diagonal();
-    for (size_t i = 0; i < d.size(); ++i) lv.dinv[i] = 1 / d[i];
-  }
+  refresh_diagonals();
   factor_coarse();
 }
 

@@ -66,6 +66,7 @@ class Multigrid : public LinearOperator {
   void vcycle(int l) const;
   void smooth(int l, bool zero_guess) const;
   void factor_coarse();
+  void refresh_diagonals();  // dinv = 1 / diag(K + B) on every level
   void estimate_lmax(Level& lv);
 
   MGOptions opt_;
