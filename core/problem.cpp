@@ -60,6 +60,7 @@ void validate(const ProblemSpec& s) {
     os << "box edges " << s.lx << " " << s.ly << " " << s.lz << " must be positive";
     fail(os.str());
   }
+  // in double: guards the int64 product in ProblemSpec::nodes() against overflow
   const double nodes = double(s.ex + 1) * double(s.ey + 1) * double(s.ez + 1);
   if (nodes > 4e8) {
     if (s.level >= 0) os << "level " << s.level << ": ";
@@ -107,7 +108,7 @@ Problem make_problem(const ProblemSpec& spec) {
 }
 
 double estimated_memory_bytes(const ProblemSpec& s) {
-  const double n = double(s.ex + 1) * double(s.ey + 1) * double(s.ez + 1);
+  const double n = double(s.nodes());
   // fine-grid vectors of 3n doubles: load 1, Steklov buffers 3, inner CG 4,
   // two multigrid hierarchies 2 x (r, d, dinv) + coarse copies, boundary
   // preconditioner 2, recovered displacement 1, set-up temporaries: measured

@@ -30,6 +30,11 @@ struct ProblemSpec {
   std::array<real, 3> traction_right{-5e8, 0, 0};  // on x = x0 + lx
   std::array<real, 3> traction_top{0, 0, -1e8};    // on z = z0 + lz
   real phi = 1;                    // Tresca bound per contact node (a force)
+
+  // sizes follow from the element counts alone (no need to build the problem)
+  index nodes() const { return (ex + 1) * (ey + 1) * (ez + 1); }
+  index contact_nodes() const { return ex * (ey + 1); }                  // bottom nodes with x > 0
+  index free_dofs() const { return 3 * (nodes() - (ey + 1) * (ez + 1)); }  // all but the x = 0 face
 };
 
 // Element counts of mesh level l (method.md §1).
@@ -46,13 +51,13 @@ struct Problem {
   unsigned dirichlet_faces = kFaceX0;              // K: u = 0 on x = 0
   unsigned interior_faces = kFaceX0 | kFaceZ0;     // K_ii: also the contact face
   std::vector<real> load;                          // l, SoA, 3N
-  index contact_nodes() const { return grid.ex * grid.ny(); }
+  index contact_nodes() const { return spec.contact_nodes(); }
   // grid node of contact node c
   index contact_grid_node(index c) const { return grid.node(1 + c % grid.ex, c / grid.ex, 0); }
   index nodes() const { return grid.nodes(); }
   index dofs() const { return 3 * grid.nodes(); }
   // unknown displacement dofs (all but the Dirichlet face)
-  index free_dofs() const { return 3 * (grid.nodes() - grid.ny() * grid.nz()); }
+  index free_dofs() const { return spec.free_dofs(); }
 };
 
 Problem make_problem(const ProblemSpec& spec);

@@ -183,13 +183,11 @@ int main(int argc, char** argv) {
     }
 
     if (!quiet) {
-      const Problem P0 = make_problem(spec);
       std::printf("tresca: mesh %s (level %s), %lld nodes, %lld contact nodes, %lld dofs, phi %g, eps %g, %d threads\n",
                   dims_string(spec).c_str(), spec.level >= 0 ? std::to_string(spec.level).c_str() : "-",
-                  (long long)P0.nodes(), (long long)P0.contact_nodes(), (long long)P0.free_dofs(), spec.phi,
+                  (long long)spec.nodes(), (long long)spec.contact_nodes(), (long long)spec.free_dofs(), spec.phi,
                   opt.newton.eps, threads);
       std::printf("        estimated peak memory %.2f GB\n", estimated_memory_bytes(spec) / 1e9);
-
     }
     const RunResult R = run_tresca(spec, opt);
     const NewtonResult& N = R.newton;
