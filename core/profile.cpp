@@ -54,10 +54,13 @@ std::string profile_table(double total) {
     // rows that contain other rows, or have no traffic model, show no rates
     const bool nested = Kernel(i) == Kernel::inner_cg || Kernel(i) == Kernel::outer_cg ||
                         Kernel(i) == Kernel::smoother || Kernel(i) == Kernel::coarse_solve;
+    char gbs[16] = "-", gflops[16] = "-";
+    if (!nested && e.seconds > 0) {
+      std::snprintf(gbs, sizeof gbs, "%.2f", e.bytes / e.seconds * 1e-9);
+      std::snprintf(gflops, sizeof gflops, "%.2f", e.flops / e.seconds * 1e-9);
+    }
     std::snprintf(line, sizeof line, "%-22s %10lld %10.3f %6.1f%% %9s %9s\n", kernel_name(Kernel(i)), e.calls,
-                  e.seconds, total > 0 ? 100 * e.seconds / total : 0.0,
-                  nested || e.seconds <= 0 ? "-" : std::to_string(e.bytes / e.seconds * 1e-9).substr(0, 6).c_str(),
-                  nested || e.seconds <= 0 ? "-" : std::to_string(e.flops / e.seconds * 1e-9).substr(0, 6).c_str());
+                  e.seconds, total > 0 ? 100 * e.seconds / total : 0.0, gbs, gflops);
     out += line;
   }
   out += "(smoother, inner and outer CG rows contain the kernel rows; their shares overlap)\n";
