@@ -11,6 +11,7 @@
 #include "core/output.hpp"
 #include "core/profile.hpp"
 #include "core/run.hpp"
+#include "kernels/simd.hpp"
 
 using namespace tresca;
 
@@ -78,7 +79,7 @@ std::string summary_json(const ProblemSpec& spec, const RunResult& R, int thread
     j.null("level");
   j.raw("dims", "[" + std::to_string(spec.ex) + ", " + std::to_string(spec.ey) + ", " + std::to_string(spec.ez) + "]")
       .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
-      .num("phi", spec.phi).num("eps", eps).integer("threads", threads).integer("newton_iterations", N.iterations)
+      .num("phi", spec.phi).num("eps", eps).integer("threads", threads).str("build", build_info()).integer("newton_iterations", N.iterations)
       .boolean("converged", N.converged()).str("reason", to_string(N.reason))
       .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())
       .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
@@ -187,7 +188,8 @@ int main(int argc, char** argv) {
                   dims_string(spec).c_str(), spec.level >= 0 ? std::to_string(spec.level).c_str() : "-",
                   (long long)spec.nodes(), (long long)spec.contact_nodes(), (long long)spec.free_dofs(), spec.phi,
                   opt.newton.eps, threads);
-      std::printf("        estimated peak memory %.2f GB\n", estimated_memory_bytes(spec) / 1e9);
+      std::printf("        estimated peak memory %.2f GB; kernels: %s\n", estimated_memory_bytes(spec) / 1e9,
+                  build_info().c_str());
     }
     const RunResult R = run_tresca(spec, opt);
     const NewtonResult& N = R.newton;
@@ -214,7 +216,8 @@ int main(int argc, char** argv) {
                 R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9);
     std::printf("times [s]: setup %.3f, condense %.3f, solve %.3f, recover %.3f, total %.3f\n", R.times.setup,
                 R.times.condense, R.times.solve, R.times.recover, R.times.total);
-    if (profile) std::printf("\n%s", profile_table(R.times.total).c_str());
+    if (profile) std::printf("\nkernel profile (%s, %d threads)\n%s", build_info().c_str(), threads,
+                             profile_table(R.times.total).c_str());
     try {
       const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status};
       if (!json_path.empty()) write_file_atomic(json_path, summary_json(spec, R, threads, opt.newton.eps) + "\n");

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "element.hpp"
+#include "simd.hpp"
 
 namespace tresca {
 namespace {
@@ -28,11 +29,10 @@ std::uint8_t axis_class(index i, index n, bool c_lo, bool c_hi) {
 bool dropped(std::uint8_t c, int d) { return (d < 0 && (c & kDropL)) || (d > 0 && (c & kDropR)); }
 
 // Accumulates the groups [g, ge) whose nonzero outputs are the mask M.
-// V is a vector of kLanes doubles (GCC/Clang vector extension; unaligned,
-// and may_alias because it reads and writes plain double arrays); each input
+// V is the target's native vector of kLanes doubles (simd.hpp); each input
 // vector is loaded once and feeds the |M| outputs.
-constexpr int kLanes = 8;
-typedef real V __attribute__((vector_size(kLanes * sizeof(real)), aligned(sizeof(real)), may_alias));
+constexpr int kLanes = Simd<real>::lanes;
+using V = Vec<real>;
 
 template <int NV, int M>
 inline void accumulate(const StencilGroup* g, const StencilGroup* ge, const real* x, V* a0, V* a1, V* a2) {
@@ -84,7 +84,10 @@ inline void stencil_block(const StencilGroup* g, const std::int32_t* f, const re
 
 inline void stencil_range(const StencilGroup* g, const std::int32_t* f, const real* x, real* y, const real* b,
                           index N, index i0, index i1) {
-  constexpr int kW = 16;
+  // three vectors per block: 9 accumulators + 3 inputs fit the 16 registers of
+  // SSE/AVX2 (and AVX-512's 32); measured best of 1..4 on AVX-512, AVX2 and
+  // SSE4.2 builds alike (perf/RESULTS.md)
+  constexpr int kW = 3 * kLanes;
   index i = i0;
   for (; i + kW <= i1; i += kW) stencil_block<kW>(g, f, x, y, b, N, i);
   for (; i + kLanes <= i1; i += kLanes) stencil_block<kLanes>(g, f, x, y, b, N, i);

@@ -8,6 +8,7 @@
 
 #include "core/multigrid.hpp"
 #include "core/problem.hpp"
+#include "kernels/simd.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 
@@ -91,4 +92,11 @@ BENCHMARK(BM_Dot)->Name("Dot")->Arg(1 << 20)->Arg(1 << 24)->UseRealTime();
 }  // namespace
 }  // namespace tresca
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  benchmark::AddCustomContext("tresca kernels", tresca::build_info());
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -8,6 +8,7 @@
 #include "core/interior.hpp"
 #include "core/output.hpp"
 #include "core/profile.hpp"
+#include "kernels/simd.hpp"
 
 using namespace tresca;
 
@@ -25,6 +26,7 @@ int main(int argc, char** argv) {
     const std::string json = a.str("--json");
     if (!json.empty()) check_writable(json);
     for (int L : levels) check_memory(spec_for_level(L));
+    std::printf("# kernels: %s, %d threads\n", build_info().c_str(), threads);
     std::printf("%5s %11s %-52s %6s %9s %9s %11s %s\n", "level", "dofs", "hierarchy", "iters", "setup[s]", "solve[s]",
                 "s/iter", "rel.res (recomputed)");
     std::string rows = "[";
@@ -43,7 +45,7 @@ int main(int argc, char** argv) {
       Json j;
       j.integer("level", L).integer("dofs", P.dofs()).integer("levels", mg.num_levels())
           .integer("iterations", st.iterations).num("setup", t1 - t0).num("solve", solve)
-          .num("relative_residual", rel).str("reason", to_string(st.reason)).integer("threads", threads);
+          .num("relative_residual", rel).str("reason", to_string(st.reason)).integer("threads", threads).str("build", build_info());
       rows += (rows.size() > 1 ? ",\n " : "") + j.render();
     }
     if (!json.empty()) write_file_atomic(json, rows + "]\n");

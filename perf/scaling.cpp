@@ -16,6 +16,7 @@
 #include "core/output.hpp"
 #include "core/profile.hpp"
 #include "core/run.hpp"
+#include "kernels/simd.hpp"
 
 using namespace tresca;
 
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
     const std::string json = a.str("--json");
     if (!json.empty()) check_writable(json);
     for (int L : levels) check_memory(spec_for_level(L));
+    std::printf("# kernels: %s\n", build_info().c_str());
     std::printf("%5s %3s %10s %8s %8s %8s %8s %8s %6s %6s %6s %6s %8s %8s %7s\n", "level", "thr", "dofs", "setup",
                 "condense", "solve", "recover", "total", "newton", "outer", "inner", "S-app", "fmv/step", "peak GB",
                 "speedup");
@@ -69,7 +71,7 @@ int main(int argc, char** argv) {
         Json times, j;
         times.num("setup", R.times.setup).num("condense", R.times.condense).num("solve", R.times.solve)
             .num("recover", R.times.recover).num("total", R.times.total);
-        j.integer("level", L).integer("threads", T).integer("dofs", R.problem->free_dofs()).raw("times", times.render())
+        j.integer("level", L).integer("threads", T).str("build", build_info()).integer("dofs", R.problem->free_dofs()).raw("times", times.render())
             .integer("newton_iterations", R.newton.iterations).boolean("converged", R.newton.converged())
             .integer("outer_iterations", R.newton.outer_iterations).integer("inner_iterations", R.inner_iterations)
             .integer("operator_applications", R.newton.operator_applications)
