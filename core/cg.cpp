@@ -66,7 +66,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
     }
     real pq;
     {
-      ScopedTimer t(Kernel::vector, 16.0 * n, 2.0 * n);
+      ScopedTimer t(Kernel::vector, n * kDotCost);
       pq = dot(n, p, q);
     }
     if (!(pq > 0)) {
@@ -76,7 +76,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
     const real alpha = rz / pq;
     if (opt.on_step) opt.on_step(alpha);
     {
-      ScopedTimer t(Kernel::vector, 48.0 * n, 6.0 * n);
+      ScopedTimer t(Kernel::vector, n * kCgUpdateCost);
       rr = cg_update(n, alpha, p, q, x, r);
     }
     st.iterations = it;
@@ -88,7 +88,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
     if (st.residual <= target) return st;
     if (opt.on_residual) opt.on_residual(st.residual);
     precondition();
-    ScopedTimer t(Kernel::vector, 40.0 * n, 4.0 * n);
+    ScopedTimer t(Kernel::vector, n * (kDotCost + kXpayCost));
     const real rz_new = dot(n, r, z);
     xpay(n, z, rz_new / rz, p);
     rz = rz_new;

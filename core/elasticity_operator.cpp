@@ -14,12 +14,12 @@ void ElasticityOperator::apply_planes(const real* x, real* y, index z_begin, ind
   const GridDims& g = k_.g;
   {
     const double nodes = double(g.nx()) * double(g.ny()) * double(z_end - z_begin);
-    ScopedTimer t(Kernel::apply, nodes * 48, nodes * 306, nodes);
+    ScopedTimer t(Kernel::apply, nodes * kApplyCost, nodes);
     elasticity_apply(k_, x, y, z_begin, z_end);
   }
   if (!B_.empty() && z_begin == 0 && z_end > 0) {
     const double m = double(g.nx()) * double(g.ny());
-    ScopedTimer t(Kernel::apply_boundary, m * 80, m * 10);
+    ScopedTimer t(Kernel::apply_boundary, m * kBottomBlockCost);
     bottom_block_apply(g, 1, B_.data(), x, y);
   }
 }
@@ -28,12 +28,12 @@ void ElasticityOperator::residual(const real* b, const real* x, real* r) const {
   const GridDims& g = k_.g;
   {
     const double nodes = double(g.nodes());
-    ScopedTimer t(Kernel::apply, nodes * 72, nodes * 315, nodes);
+    ScopedTimer t(Kernel::apply, nodes * kResidualCost, nodes);
     elasticity_apply(k_, x, r, 0, g.nz(), b);
   }
   if (!B_.empty()) {
     const double m = double(g.nx()) * double(g.ny());
-    ScopedTimer t(Kernel::apply_boundary, m * 80, m * 13);
+    ScopedTimer t(Kernel::apply_boundary, m * kBottomBlockCost);
     bottom_block_apply(g, -1, B_.data(), x, r);
   }
 }

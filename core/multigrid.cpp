@@ -180,7 +180,7 @@ void Multigrid::vcycle(int l) const {
   lv.A.residual(lv.bp, lv.xp, lv.r.data());
   {
     const double nf = double(n);
-    ScopedTimer t(Kernel::restrict_, nf * 8 * 1.3, nf * 2 * 8 / 8 * 8);
+    ScopedTimer t(Kernel::restrict_, nf * kRestrictCost);
     restrict_to_coarse(lv.to_coarse, 3, lv.r.data(), c.b.data());
     zero_constrained(c.A.grid(), c.A.faces(), c.b.data());
   }
@@ -189,7 +189,7 @@ void Multigrid::vcycle(int l) const {
     // x += P x_c; the correction vanishes on constrained faces (they are
     // interpolated from constrained coarse nodes only), the mask makes it exact
     const double nf = double(n);
-    ScopedTimer t(Kernel::prolongate, nf * 8 * 2.3, nf * 16);
+    ScopedTimer t(Kernel::prolongate, nf * kProlongateCost);
     prolongate(lv.to_coarse, 3, c.x.data(), lv.xp, true);
     zero_constrained(lv.A.grid(), lv.A.faces(), lv.xp);
   }

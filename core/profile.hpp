@@ -32,8 +32,9 @@ double peak_memory_bytes();
 
 class ScopedTimer {
  public:
-  ScopedTimer(Kernel k, double bytes = 0, double flops = 0, double items = 0)
-      : k_(k), b_(bytes), f_(flops), n_(items), t0_(wall_time()) {}
+  // cost: the kernel's modelled traffic and flops (n * kSomeCost); items: work items
+  explicit ScopedTimer(Kernel k, Cost cost = {}, double items = 0)
+      : k_(k), b_(cost.bytes), f_(cost.flops), n_(items), t0_(wall_time()) {}
   ~ScopedTimer() { profile_add(k_, wall_time() - t0_, b_, f_, n_); }
   ScopedTimer(const ScopedTimer&) = delete;
   ScopedTimer& operator=(const ScopedTimer&) = delete;

@@ -120,7 +120,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     // residual map and approximation step
     real vnorm;
     {
-      ScopedTimer t(Kernel::contact_maps, double(p) * 120, double(p) * 30);
+      ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
       for (index i = 0; i < n3; ++i) r[i] = R.Su[i] - btilde[i];
       vnorm = std::sqrt(approximation_step(p, phi, R.u.data(), R.lambda.data(), r.data(), v.data(), d.data(),
                                            R.status.data()));

@@ -5,11 +5,13 @@
 //
 // DATA LAYOUT: B is 4 consecutive fields of nx*ny values (bxx, bxy, byy, bzz)
 // indexed by ix + nx*iy; x, y are SoA grid fields (grid.hpp).
-// Cost per bottom node: 6 reads of B/x, 3 updates, 10 flops.
+// Cost per bottom node: reads 4 B fields, 3 x and 3 y, writes 3 y; 13 flops.
 #pragma once
 #include "grid.hpp"
 
 namespace tresca {
+
+constexpr Cost kBottomBlockCost{104, 13};  // per bottom-face node
 
 void bottom_block_apply(const GridDims& g, real alpha, const real* B, const real* x, real* y);
 void bottom_block_apply_ref(const GridDims& g, real alpha, const real* B, const real* x, real* y);

@@ -21,6 +21,8 @@ namespace tresca {
 
 enum : std::uint8_t { kContact = 1, kStick = 2 };
 
+constexpr Cost kApproximationStepCost{120, 30};  // per contact node
+
 // Writes v, d, status; returns sum of v^2 (deterministic order).
 real approximation_step(index p, real phi, const real* u, const real* lambda, const real* r, real* v, real* d,
                         std::uint8_t* status);

@@ -67,6 +67,11 @@ ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, re
 // z_begin = 0, z_end = g.nz()). With b != nullptr the residual y = b - K x is
 // written instead (fused: one extra input stream, no extra pass). OpenMP over
 // x-rows.
+// per output node: y = K x reads x and writes y (3 components each; neighbour
+// rows come from cache), 153 FMAs; the residual b - K x also reads b.
+constexpr Cost kApplyCost{48, 306};
+constexpr Cost kResidualCost{72, 309};
+
 void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
                       const real* b = nullptr);
 void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,

@@ -23,6 +23,12 @@
 
 namespace tresca {
 
+// per fine dof (3 components count as 3): prolongation (accumulating) reads and
+// writes the fine value plus 1/8 of a coarse one; restriction reads the fine
+// value and writes 1/8 of a coarse one; 16 flops each.
+constexpr Cost kProlongateCost{18.4, 16};
+constexpr Cost kRestrictCost{10.4, 16};
+
 struct Interp1D {
   // fine node i interpolates from coarse j0[i] (weight 1-w[i]) and j0[i]+1 (weight w[i])
   std::vector<index> j0;

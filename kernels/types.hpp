@@ -6,4 +6,13 @@
 namespace tresca {
 using real = double;
 using index = std::int64_t;
+
+// Modelled cost of a kernel per work item: bytes moved to or from memory (no
+// write-allocate) and flops. Each kernel header states its own, once; the
+// profiler, benchmarks and perf/roofline scale them by the item count.
+struct Cost {
+  double bytes = 0, flops = 0;
+};
+constexpr Cost operator*(double n, Cost c) { return {n * c.bytes, n * c.flops}; }
+constexpr Cost operator+(Cost a, Cost b) { return {a.bytes + b.bytes, a.flops + b.flops}; }
 }  // namespace tresca

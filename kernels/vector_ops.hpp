@@ -15,6 +15,9 @@
 namespace tresca {
 
 constexpr index kDotBlock = 4096;
+// per entry (the table above)
+constexpr Cost kDotCost{16, 2}, kAxpyCost{24, 2}, kXpayCost{24, 2}, kCgUpdateCost{48, 6}, kChebUpdateCost{40, 5},
+    kChebFirstCost{32, 2};
 
 real dot(index n, const real* x, const real* y);
 real dot_ref(index n, const real* x, const real* y);
@@ -32,7 +35,5 @@ real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real*
 void cheb_update(index n, real s, real t, const real* dinv, const real* r, real* d, real* x);
 // first Chebyshev step from x = 0: d = t dinv .* b; x = d
 void cheb_first(index n, real t, const real* dinv, const real* b, real* d, real* x);
-// true if every entry is finite
-bool all_finite(index n, const real* x);
 
 }  // namespace tresca

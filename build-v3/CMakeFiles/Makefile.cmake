@@ -62,5 +62,6 @@ set(CMAKE_DEPEND_INFO_FILES
   "CMakeFiles/elastic.dir/DependInfo.cmake"
   "CMakeFiles/scaling.dir/DependInfo.cmake"
   "CMakeFiles/mg_scaling.dir/DependInfo.cmake"
+  "CMakeFiles/roofline.dir/DependInfo.cmake"
   "CMakeFiles/bench_kernels.dir/DependInfo.cmake"
   )

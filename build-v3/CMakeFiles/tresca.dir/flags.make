@@ -6,5 +6,5 @@ CXX_DEFINES =
 
 CXX_INCLUDES = -I/work/main -isystem /usr/include/eigen3
 
-CXX_FLAGS = -march=x86-64-v3 -O3 -DNDEBUG -Wall -Wextra -Wno-maybe-uninitialized -fopenmp -std=c++17
+CXX_FLAGS = -O3 -DNDEBUG -Wall -Wextra -Wno-maybe-uninitialized -march=x86-64-v3 -fopenmp -std=c++17
 

@@ -12,6 +12,7 @@ set(CMAKE_DEPENDS_DEPENDENCY_FILES
   "/work/main/kernels/contact_maps.cpp" "CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o" "gcc" "CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o.d"
   "/work/main/kernels/elasticity.cpp" "CMakeFiles/tresca_kernels.dir/kernels/elasticity.cpp.o" "gcc" "CMakeFiles/tresca_kernels.dir/kernels/elasticity.cpp.o.d"
   "/work/main/kernels/element.cpp" "CMakeFiles/tresca_kernels.dir/kernels/element.cpp.o" "gcc" "CMakeFiles/tresca_kernels.dir/kernels/element.cpp.o.d"
+  "/work/main/kernels/simd.cpp" "CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o" "gcc" "CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o.d"
   "/work/main/kernels/transfer.cpp" "CMakeFiles/tresca_kernels.dir/kernels/transfer.cpp.o" "gcc" "CMakeFiles/tresca_kernels.dir/kernels/transfer.cpp.o.d"
   "/work/main/kernels/vector_ops.cpp" "CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o" "gcc" "CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o.d"
   )

@@ -111,10 +111,24 @@ CMakeFiles/tresca_kernels.dir/kernels/transfer.cpp.s: cmake_force
 	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Compiling CXX source to assembly CMakeFiles/tresca_kernels.dir/kernels/transfer.cpp.s"
 	/usr/bin/c++ $(CXX_DEFINES) $(CXX_INCLUDES) $(CXX_FLAGS) -S /work/main/kernels/transfer.cpp -o CMakeFiles/tresca_kernels.dir/kernels/transfer.cpp.s
 
+CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o: CMakeFiles/tresca_kernels.dir/flags.make
+CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o: /work/main/kernels/simd.cpp
+CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o: CMakeFiles/tresca_kernels.dir/compiler_depend.ts
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build-v3/CMakeFiles --progress-num=$(CMAKE_PROGRESS_4) "Building CXX object CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o"
+	/usr/bin/c++ $(CXX_DEFINES) $(CXX_INCLUDES) $(CXX_FLAGS) -MD -MT CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o -MF CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o.d -o CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o -c /work/main/kernels/simd.cpp
+
+CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.i: cmake_force
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Preprocessing CXX source to CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.i"
+	/usr/bin/c++ $(CXX_DEFINES) $(CXX_INCLUDES) $(CXX_FLAGS) -E /work/main/kernels/simd.cpp > CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.i
+
+CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.s: cmake_force
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green "Compiling CXX source to assembly CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.s"
+	/usr/bin/c++ $(CXX_DEFINES) $(CXX_INCLUDES) $(CXX_FLAGS) -S /work/main/kernels/simd.cpp -o CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.s
+
 CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o: CMakeFiles/tresca_kernels.dir/flags.make
 CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o: /work/main/kernels/vector_ops.cpp
 CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o: CMakeFiles/tresca_kernels.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build-v3/CMakeFiles --progress-num=$(CMAKE_PROGRESS_4) "Building CXX object CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build-v3/CMakeFiles --progress-num=$(CMAKE_PROGRESS_5) "Building CXX object CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o"
 	/usr/bin/c++ $(CXX_DEFINES) $(CXX_INCLUDES) $(CXX_FLAGS) -MD -MT CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o -MF CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o.d -o CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o -c /work/main/kernels/vector_ops.cpp
 
 CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.i: cmake_force
@@ -128,7 +142,7 @@ CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.s: cmake_force
 CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.o: CMakeFiles/tresca_kernels.dir/flags.make
 CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.o: /work/main/kernels/boundary_block.cpp
 CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.o: CMakeFiles/tresca_kernels.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build-v3/CMakeFiles --progress-num=$(CMAKE_PROGRESS_5) "Building CXX object CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build-v3/CMakeFiles --progress-num=$(CMAKE_PROGRESS_6) "Building CXX object CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.o"
 	/usr/bin/c++ $(CXX_DEFINES) $(CXX_INCLUDES) $(CXX_FLAGS) -MD -MT CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.o -MF CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.o.d -o CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.o -c /work/main/kernels/boundary_block.cpp
 
 CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.i: cmake_force
@@ -142,7 +156,7 @@ CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.s: cmake_force
 CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o: CMakeFiles/tresca_kernels.dir/flags.make
 CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o: /work/main/kernels/contact_maps.cpp
 CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o: CMakeFiles/tresca_kernels.dir/compiler_depend.ts
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build-v3/CMakeFiles --progress-num=$(CMAKE_PROGRESS_6) "Building CXX object CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --progress-dir=/work/main/build-v3/CMakeFiles --progress-num=$(CMAKE_PROGRESS_7) "Building CXX object CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o"
 	/usr/bin/c++ $(CXX_DEFINES) $(CXX_INCLUDES) $(CXX_FLAGS) -MD -MT CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o -MF CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o.d -o CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o -c /work/main/kernels/contact_maps.cpp
 
 CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.i: cmake_force
@@ -158,6 +172,7 @@ tresca_kernels_OBJECTS = \
 "CMakeFiles/tresca_kernels.dir/kernels/element.cpp.o" \
 "CMakeFiles/tresca_kernels.dir/kernels/elasticity.cpp.o" \
 "CMakeFiles/tresca_kernels.dir/kernels/transfer.cpp.o" \
+"CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o" \
 "CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o" \
 "CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.o" \
 "CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o"
@@ -168,12 +183,13 @@ tresca_kernels_EXTERNAL_OBJECTS =
 libtresca_kernels.a: CMakeFiles/tresca_kernels.dir/kernels/element.cpp.o
 libtresca_kernels.a: CMakeFiles/tresca_kernels.dir/kernels/elasticity.cpp.o
 libtresca_kernels.a: CMakeFiles/tresca_kernels.dir/kernels/transfer.cpp.o
+libtresca_kernels.a: CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o
 libtresca_kernels.a: CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o
 libtresca_kernels.a: CMakeFiles/tresca_kernels.dir/kernels/boundary_block.cpp.o
 libtresca_kernels.a: CMakeFiles/tresca_kernels.dir/kernels/contact_maps.cpp.o
 libtresca_kernels.a: CMakeFiles/tresca_kernels.dir/build.make
 libtresca_kernels.a: CMakeFiles/tresca_kernels.dir/link.txt
-	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --bold --progress-dir=/work/main/build-v3/CMakeFiles --progress-num=$(CMAKE_PROGRESS_7) "Linking CXX static library libtresca_kernels.a"
+	@$(CMAKE_COMMAND) -E cmake_echo_color --switch=$(COLOR) --green --bold --progress-dir=/work/main/build-v3/CMakeFiles --progress-num=$(CMAKE_PROGRESS_8) "Linking CXX static library libtresca_kernels.a"
 	$(CMAKE_COMMAND) -P CMakeFiles/tresca_kernels.dir/cmake_clean_target.cmake
 	$(CMAKE_COMMAND) -E cmake_link_script CMakeFiles/tresca_kernels.dir/link.txt --verbose=$(VERBOSE)
 

@@ -7,6 +7,8 @@ file(REMOVE_RECURSE
   "CMakeFiles/tresca_kernels.dir/kernels/elasticity.cpp.o.d"
   "CMakeFiles/tresca_kernels.dir/kernels/element.cpp.o"
   "CMakeFiles/tresca_kernels.dir/kernels/element.cpp.o.d"
+  "CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o"
+  "CMakeFiles/tresca_kernels.dir/kernels/simd.cpp.o.d"
   "CMakeFiles/tresca_kernels.dir/kernels/transfer.cpp.o"
   "CMakeFiles/tresca_kernels.dir/kernels/transfer.cpp.o.d"
   "CMakeFiles/tresca_kernels.dir/kernels/vector_ops.cpp.o"

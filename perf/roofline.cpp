@@ -1,0 +1,204 @@
+// Each kernel against this machine's own limits, in one run.
+//
+// First the machine: streaming bandwidth by the STREAM triad a = b + s c
+// (arrays far larger than the caches, first-touch placement by the same
+// threads), reported as STREAM counts it (24 bytes per entry) and as the
+// traffic it really causes (32 bytes: writing a also reads it into cache,
+// write-allocate). The latter is the bound used below, because in-place
+// updates (axpy, cg_update) move exactly their modelled bytes. Then the flop peak of the build's vectors
+// (independent FMA chains in registers, Vec<double> of kernels/simd.hpp).
+// Then every kernel on the fields of mesh level L, timed best of several
+// repetitions, with its modelled bytes and flops (the Cost constants in the
+// kernel headers). A kernel's roofline bound is max(bytes / triad, flops /
+// peak); "of bound" is that bound over the measured time (100 % = at the
+// roof). Output: one aligned table, and with --json FILE the same as JSON.
+//   OMP_NUM_THREADS=2 build/bin/roofline --level 10 --json roofline.json
+#include <omp.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/cli.hpp"
+#include "core/multigrid.hpp"
+#include "core/output.hpp"
+#include "core/problem.hpp"
+#include "core/profile.hpp"
+#include "kernels/boundary_block.hpp"
+#include "kernels/contact_maps.hpp"
+#include "kernels/elasticity.hpp"
+#include "kernels/simd.hpp"
+#include "kernels/transfer.hpp"
+#include "kernels/vector_ops.hpp"
+
+using namespace tresca;
+
+namespace {
+
+double best_of(int reps, const std::function<void()>& f) {
+  f();  // warm-up: page faults, caches
+  double best = 1e300;
+  for (int r = 0; r < reps; ++r) {
+    const double t0 = wall_time();
+    f();
+    best = std::min(best, wall_time() - t0);
+  }
+  return best;
+}
+
+// STREAM triad, bytes per second as STREAM counts them (24 per entry)
+double triad_bandwidth(tresca::index n, int reps) {
+  std::vector<real> a, b, c;
+  a.reserve(n);
+  b.reserve(n);
+  c.reserve(n);
+  real *pa = a.data(), *pb = b.data(), *pc = c.data();
+#pragma omp parallel for schedule(static)
+  for (tresca::index i = 0; i < n; ++i) {
+    pa[i] = 0;
+    pb[i] = 1;
+    pc[i] = 2;
+  }
+  const real s = 3;
+  const double t = best_of(reps, [&] {
+#pragma omp parallel for simd schedule(static)
+    for (tresca::index i = 0; i < n; ++i) pa[i] = pb[i] + s * pc[i];
+  });
+  if (pa[n / 2] != 7) std::fprintf(stderr, "roofline: triad check failed\n");
+  return 24.0 * double(n) / t;
+}
+
+// peak flop/s of the build's vectors: K independent FMA chains per thread
+double fma_peak(long iterations) {
+  using V = Vec<real>;
+  constexpr int K = 12;
+  real sink = 0;
+  const double t = best_of(3, [&] {
+    real total = 0;
+#pragma omp parallel reduction(+ : total)
+    {
+      V acc[K];
+      for (int k = 0; k < K; ++k) acc[k] = V{} + real(k + 1) * 1e-3;
+      const V a = V{} + real(0.999999), b = V{} + real(1e-7);
+      for (long it = 0; it < iterations; ++it)
+        for (int k = 0; k < K; ++k) acc[k] = acc[k] * a + b;
+      for (int k = 0; k < K; ++k)
+        for (int l = 0; l < Simd<real>::lanes; ++l) total += acc[k][l];
+    }
+    sink += total;
+  });
+  if (!(sink > 0)) std::fprintf(stderr, "roofline: FMA check failed\n");
+  return 2.0 * K * Simd<real>::lanes * double(iterations) * omp_get_max_threads() / t;
+}
+
+struct Row {
+  std::string name;
+  double items, seconds;
+  Cost cost;  // total for one call
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    Args a(argc, argv, {"--level", "--threads", "--reps", "--json"}, {"--help"});
+    if (a.has("--help")) {
+      std::puts("usage: roofline [--level 10] [--threads N] [--reps 20] [--json FILE]");
+      return 0;
+    }
+    const int threads = apply_threads(a);
+    const long long level = a.int_value("--level", 10);
+    const long long reps = a.int_value("--reps", 20);
+    if (reps < 1 || reps > 100000) throw std::invalid_argument("--reps " + a.str("--reps") + " must be in 1..100000");
+    const ProblemSpec spec = spec_for_level(int(level));
+    check_memory(spec);
+    const std::string json = a.str("--json");
+    if (!json.empty()) check_writable(json);
+
+    const double stream = triad_bandwidth(tresca::index(1) << 25, int(std::min(reps, 10LL)));
+    const double bw = stream * 32.0 / 24.0;  // with the write-allocate read of a
+    const double peak = fma_peak(20000000);
+    std::printf("# %s, %d threads\n", build_info().c_str(), threads);
+    std::printf("# machine: triad %.2f GB/s (STREAM count), %.2f GB/s of traffic with write-allocate (the bound);\n"
+                "#          FMA peak %.2f GFLOP/s; machine balance %.1f flop/byte\n",
+                stream * 1e-9, bw * 1e-9, peak * 1e-9, peak / bw);
+
+    const Problem P = make_problem(spec);
+    const GridDims& g = P.grid;
+    const tresca::index N = g.nodes(), n = 3 * N, M = g.nx() * g.ny();
+    const ElasticityStencil k = build_elasticity_stencil(g, P.interior_faces, P.spec.E, P.spec.nu);
+    std::vector<real> x(n), y(n), b(n), z(n), w(n), B(4 * M, 1.0);
+    for (tresca::index i = 0; i < n; ++i) {
+      x[i] = real((i * 7919) % 1000) * 1e-3;
+      b[i] = real((i * 104729) % 1000) * 1e-3;
+    }
+    GridDims c = g;
+    c.ex = (c.ex + 1) / 2;
+    c.ey = (c.ey + 1) / 2;
+    c.ez = (c.ez + 1) / 2;
+    const Transfer t = build_transfer(g, c);
+    std::vector<real> xc(3 * c.nodes(), 0.5);
+    Multigrid mg(g, P.interior_faces, P.spec.E, P.spec.nu);
+    // the approximation step on as many nodes as the grid has (a streaming
+    // size; the benchmark's own contact face is small enough to sit in cache)
+    std::vector<real> lam(N, 1.0), v(4 * N), d(3 * N);
+    std::vector<std::uint8_t> status(N);
+
+    const int R = int(reps);
+    const double nodes = double(N), dofs = double(n);
+    std::vector<Row> rows;
+    auto add = [&](const char* name, double items, Cost cost, const std::function<void()>& f) {
+      rows.push_back({name, items, best_of(R, f), cost});
+    };
+    add("apply y = Kx", dofs, nodes * kApplyCost, [&] { elasticity_apply(k, x.data(), y.data(), 0, g.nz()); });
+    add("residual b - Kx", dofs, nodes * kResidualCost,
+        [&] { elasticity_apply(k, x.data(), y.data(), 0, g.nz(), b.data()); });
+    add("bottom block", 3.0 * M, double(M) * kBottomBlockCost,
+        [&] { bottom_block_apply(g, 1e-9, B.data(), x.data(), y.data()); });
+    add("restriction", dofs, dofs * kRestrictCost, [&] { restrict_to_coarse(t, 3, x.data(), xc.data()); });
+    add("prolongation (+=)", dofs, dofs * kProlongateCost, [&] { prolongate(t, 3, xc.data(), y.data(), true); });
+    add("dot", dofs, dofs * kDotCost, [&] { w[0] += 1e-300 * dot(n, x.data(), b.data()); });
+    add("axpy", dofs, dofs * kAxpyCost, [&] { axpy(n, 1e-9, x.data(), y.data()); });
+    add("cg_update", dofs, dofs * kCgUpdateCost, [&] { cg_update(n, 1e-9, x.data(), b.data(), z.data(), w.data()); });
+    add("cheb_update", dofs, dofs * kChebUpdateCost,
+        [&] { cheb_update(n, 0.5, 1e-9, b.data(), x.data(), w.data(), z.data()); });
+    add("approximation step", nodes, nodes * kApproximationStepCost, [&] {
+      approximation_step(N, 1.0, x.data(), lam.data(), b.data(), v.data(), d.data(), status.data());
+    });
+    add("V-cycle (K_ii)", dofs, Cost{}, [&] { mg.apply(b.data(), y.data()); });
+
+    std::printf("# level %lld: mesh %s, %lld dofs\n", level, dims_string(spec).c_str(), (long long)n);
+    std::printf("%-20s %10s %11s %8s %8s %9s %8s %9s\n", "kernel", "time [ms]", "M items/s", "GB/s", "of BW",
+                "GFLOP/s", "of peak", "of bound");
+    std::string out = "{\"build\": \"" + build_info() + "\", \"threads\": " + std::to_string(threads) +
+                      ", \"level\": " + std::to_string(level) + ", \"triad_stream_bytes_per_s\": " + std::to_string(stream) +
+                      ", \"bandwidth_bytes_per_s\": " + std::to_string(bw) +
+                      ", \"peak_flops_per_s\": " + std::to_string(peak) + ", \"kernels\": [";
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const Row& r = rows[i];
+      const double gbs = r.cost.bytes / r.seconds, gfs = r.cost.flops / r.seconds;
+      const double bound = std::max(r.cost.bytes / bw, r.cost.flops / peak);
+      if (r.cost.bytes > 0)
+        std::printf("%-20s %10.3f %11.1f %8.2f %7.0f%% %9.2f %7.0f%% %8.0f%%\n", r.name.c_str(), r.seconds * 1e3,
+                    r.items / r.seconds * 1e-6, gbs * 1e-9, 100 * gbs / bw, gfs * 1e-9, 100 * gfs / peak,
+                    100 * bound / r.seconds);
+      else
+        std::printf("%-20s %10.3f %11.1f %8s %8s %9s %8s %9s\n", r.name.c_str(), r.seconds * 1e3,
+                    r.items / r.seconds * 1e-6, "-", "-", "-", "-", "-");
+      Json j;
+      j.str("kernel", r.name).num("seconds", r.seconds).num("items_per_s", r.items / r.seconds)
+          .num("bytes_per_s", gbs).num("flops_per_s", gfs).num("fraction_of_bandwidth", gbs / bw)
+          .num("fraction_of_peak", gfs / peak).num("fraction_of_bound", bound / r.seconds);
+      out += (i ? ",\n  " : "\n  ") + j.render();
+    }
+    out += "]}\n";
+    if (!json.empty()) write_file_atomic(json, out);
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "roofline: error: %s\n", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,63 @@
+// The blocked, parallel vector kernels against their serial _ref twins on
+// awkward lengths (below, at and across the block size), and their bitwise
+// independence of the thread count.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+
+#include "kernels/vector_ops.hpp"
+#include "test_helpers.hpp"
+
+namespace tresca {
+
+namespace {
+const index kLengths[] = {1, 7, 597, kDotBlock - 1, kDotBlock, kDotBlock + 1, 5 * kDotBlock + 43, 100003};
+}
+
+TEST(VectorOps, DotAndCgUpdateMatchReferenceOnAwkwardLengths) {
+  for (index n : kLengths) {
+    const auto x = test::random_vector(n, 1), y = test::random_vector(n, 2);
+    const real d = dot(n, x.data(), y.data()), dr = dot_ref(n, x.data(), y.data());
+    EXPECT_NEAR(d, dr, 1e-13 * double(n)) << "n = " << n;
+    auto x1 = test::random_vector(n, 3), r1 = test::random_vector(n, 4);
+    auto x2 = x1, r2 = r1;
+    const real rr = cg_update(n, 0.37, x.data(), y.data(), x1.data(), r1.data());
+    const real rr_ref = cg_update_ref(n, 0.37, x.data(), y.data(), x2.data(), r2.data());
+    EXPECT_NEAR(rr, rr_ref, 1e-13 * rr_ref) << "n = " << n;
+    EXPECT_LT(test::max_abs_diff(x1, x2), 1e-15);
+    EXPECT_LT(test::max_abs_diff(r1, r2), 1e-15);
+  }
+}
+
+TEST(VectorOps, ReductionsAreBitwiseIndependentOfThreadCount) {
+  const index n = 100003;
+  const auto x = test::random_vector(n, 5), y = test::random_vector(n, 6);
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const real d1 = dot(n, x.data(), y.data());
+  omp_set_num_threads(2);
+  const real d2 = dot(n, x.data(), y.data());
+  omp_set_num_threads(threads);
+  EXPECT_EQ(d1, d2);
+}
+
+TEST(VectorOps, ChebyshevUpdatesFollowTheirFormulas) {
+  const index n = 1001;
+  const auto dinv = test::random_vector(n, 7), r = test::random_vector(n, 8);
+  auto d = test::random_vector(n, 9), x = test::random_vector(n, 10);
+  const auto d0 = d, x0 = x;
+  cheb_update(n, 0.3, 0.7, dinv.data(), r.data(), d.data(), x.data());
+  for (index i = 0; i < n; ++i) {
+    const real di = 0.3 * d0[i] + 0.7 * dinv[i] * r[i];
+    ASSERT_NEAR(d[i], di, 1e-15);
+    ASSERT_NEAR(x[i], x0[i] + di, 1e-15);
+  }
+  cheb_first(n, 0.5, dinv.data(), r.data(), d.data(), x.data());
+  for (index i = 0; i < n; ++i) {
+    ASSERT_NEAR(d[i], 0.5 * dinv[i] * r[i], 1e-15);
+    ASSERT_EQ(x[i], d[i]);
+  }
+}
+
+}  // namespace tresca
