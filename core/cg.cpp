@@ -29,7 +29,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
   SolveStats st;
   st.rhs_norm = norm2(n, b);
   if (opt.zero_initial_guess) {
-    fill(n, 0, x);
+    fill<real>(n, 0, x);
     copy(n, b, r);
   } else {
     A.apply(x, q);

@@ -20,7 +20,7 @@ void ElasticityOperator::apply_planes(const real* x, real* y, index z_begin, ind
   if (!B_.empty() && z_begin == 0 && z_end > 0) {
     const double m = double(g.nx()) * double(g.ny());
     ScopedTimer t(Kernel::apply_boundary, m * kBottomBlockCost);
-    bottom_block_apply(g, 1, B_.data(), x, y);
+    bottom_block_apply<real>(g, 1, B_.data(), x, y);
   }
 }
 
@@ -34,7 +34,7 @@ void ElasticityOperator::residual(const real* b, const real* x, real* r) const {
   if (!B_.empty()) {
     const double m = double(g.nx()) * double(g.ny());
     ScopedTimer t(Kernel::apply_boundary, m * kBottomBlockCost);
-    bottom_block_apply(g, -1, B_.data(), x, r);
+    bottom_block_apply<real>(g, -1, B_.data(), x, r);
   }
 }
 

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
+#include "../kernels/boundary_block.hpp"
 #include "../kernels/vector_ops.hpp"
 #include "profile.hpp"
 
@@ -30,53 +32,90 @@ GridDims coarsen(const GridDims& g) {
 }
 }  // namespace
 
+const char* to_string(Precision p) { return p == Precision::single_precision ? "single" : "double"; }
+
 Multigrid::Multigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt) : opt_(opt) {
   GridDims g = fine;
   for (;;) {
     Level lv;
     lv.A = ElasticityOperator(g, faces, E, nu);
-    const index n = lv.A.size();
-    if (!levels_.empty()) {  // level 0 solves in the caller's arrays
-      lv.x.resize(n);
-      lv.b.resize(n);
-    }
-    lv.r.resize(n);
-    lv.d.resize(n);
     const bool last = g.nodes() <= opt.coarse_nodes || (g.ex == 1 && g.ey == 1 && g.ez == 1);
     const GridDims coarse = last ? g : coarsen(g);
     if (!last) lv.to_coarse = build_transfer(g, coarse);
     levels_.push_back(std::move(lv));
-    if (levels_.size() > 1) {
-      levels_.back().xp = levels_.back().x.data();
-      levels_.back().bp = levels_.back().b.data();
-    }
     if (last) break;
     g = coarse;
   }
-  refresh_diagonals();
   for (size_t l = 0; l + 1 < levels_.size(); ++l) estimate_lmax(levels_[l]);
   factor_coarse();
+  if (opt_.precision == Precision::single_precision)
+    build_work<float>();
+  else
+    build_work<double>();
 }
 
-void Multigrid::refresh_diagonals() {
-  for (auto& lv : levels_) {
-    const std::vector<real> d = lv.A.diagonal();
-    lv.dinv.resize(d.size());
-    for (size_t i = 0; i < d.size(); ++i) lv.dinv[i] = 1 / d[i];
+template <>
+std::vector<Multigrid::Work<double>>& Multigrid::work<double>() {
+  return work_d_;
+}
+template <>
+std::vector<Multigrid::Work<float>>& Multigrid::work<float>() {
+  return work_s_;
+}
+template <>
+const std::vector<Multigrid::Work<double>>& Multigrid::work<double>() const {
+  return work_d_;
+}
+template <>
+const std::vector<Multigrid::Work<float>>& Multigrid::work<float>() const {
+  return work_s_;
+}
+
+template <class T>
+void Multigrid::build_work() {
+  std::vector<Work<T>>& W = work<T>();
+  W.resize(levels_.size());
+  for (size_t l = 0; l < levels_.size(); ++l) {
+    Work<T>& w = W[l];
+    const index n = levels_[l].A.size();
+    w.k = stencil_in_precision<T>(levels_[l].A.stencil());
+    w.r.resize(n);
+    w.d.resize(n);
+    // a double level 0 solves in the caller's arrays (apply sets xp, bp)
+    if (l > 0 || !std::is_same<T, real>::value) {
+      w.x.resize(n);
+      w.b.resize(n);
+      w.xp = w.x.data();
+      w.bp = w.b.data();
+    }
+  }
+  refresh_work<T>();
+}
+
+template <class T>
+void Multigrid::refresh_work() {
+  std::vector<Work<T>>& W = work<T>();
+  for (size_t l = 0; l < levels_.size(); ++l) {
+    const std::vector<real> d = levels_[l].A.diagonal();
+    W[l].dinv.resize(d.size());
+    for (size_t i = 0; i < d.size(); ++i) W[l].dinv[i] = T(1 / d[i]);
+    const std::vector<real>& B = levels_[l].A.bottom_block();
+    W[l].B.assign(B.begin(), B.end());
   }
 }
 
 void Multigrid::estimate_lmax(Level& lv) {
   // Lanczos through Jacobi-PCG: T_jj = 1/a_j + b_{j-1}/a_{j-1}, T_j,j+1 = sqrt(b_j)/a_j
   const index n = lv.A.size();
-  std::vector<real> x(n, 0), r(n), z(n), p(n), q(n);
+  std::vector<real> x(n, 0), r(n), z(n), p(n), q(n), dinv = lv.A.diagonal();
+  for (real& v : dinv) v = 1 / v;
   std::uint64_t s = 12345;
   for (index i = 0; i < n; ++i) {
     s = s * 6364136223846793005ULL + 1442695040888963407ULL;
     r[i] = real((s >> 11) & 0xFFFFF) / real(0xFFFFF) - 0.5;
   }
   zero_constrained(lv.A.grid(), lv.A.faces(), r.data());
-  hadamard(n, lv.dinv.data(), r.data(), z.data());
+  hadamard(n, dinv.data(), r.data(), z.data());
   copy(n, z.data(), p.data());
   real rz = dot(n, r.data(), z.data());
   std::vector<real> al, be;
@@ -85,7 +124,7 @@ void Multigrid::estimate_lmax(Level& lv) {
     lv.A.apply(p.data(), q.data());
     const real a = rz / dot(n, p.data(), q.data());
     cg_update(n, a, p.data(), q.data(), x.data(), r.data());
-    hadamard(n, lv.dinv.data(), r.data(), z.data());
+    hadamard(n, dinv.data(), r.data(), z.data());
     const real rz_new = dot(n, r.data(), z.data());
     al.push_back(a);
     be.push_back(rz_new / rz);
@@ -136,70 +175,101 @@ void Multigrid::set_bottom_block(const std::vector<real>& B) {
         }
     c.A.set_bottom_block(std::move(Bc));
   }
-  refresh_diagonals();
   factor_coarse();
+  if (opt_.precision == Precision::single_precision)
+    refresh_work<float>();
+  else
+    refresh_work<double>();
 }
 
+template <class T>
+void Multigrid::residual(int l, const T* b, const T* x, T* r) const {
+  const Work<T>& w = work<T>()[l];
+  const GridDims& g = w.k.g;
+  {
+    const double nodes = double(g.nodes());
+    ScopedTimer t(Kernel::apply, nodes * in_precision<T>(kResidualCost), nodes);
+    elasticity_apply<T>(w.k, x, r, 0, g.nz(), b);
+  }
+  if (!w.B.empty()) {
+    const double m = double(g.nx()) * double(g.ny());
+    ScopedTimer t(Kernel::apply_boundary, m * in_precision<T>(kBottomBlockCost));
+    bottom_block_apply<T>(g, T(-1), w.B.data(), x, r);
+  }
+}
+
+template <class T>
 void Multigrid::smooth(int l, bool zero_guess) const {
-  const Level& lv = levels_[l];
-  const index n = lv.A.size();
+  const Work<T>& w = work<T>()[l];
+  const index n = levels_[l].A.size();
   ScopedTimer t(Kernel::smoother);
-  const real lmax = lv.lmax, lmin = lmax / opt_.range;
+  const real lmax = levels_[l].lmax, lmin = lmax / opt_.range;
   const real theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
-  real* x = lv.xp;
-  real* r = lv.r.data();
-  real* d = lv.d.data();
+  T* x = w.xp;
+  T* r = w.r.data();
+  T* d = w.d.data();
   if (zero_guess) {
-    cheb_first(n, 1 / theta, lv.dinv.data(), lv.bp, d, x);
+    cheb_first<T>(n, T(1 / theta), w.dinv.data(), w.bp, d, x);
   } else {
-    lv.A.residual(lv.bp, x, r);
-    fill(n, 0, d);
-    cheb_update(n, 0, 1 / theta, lv.dinv.data(), r, d, x);
+    residual<T>(l, w.bp, x, r);
+    fill<T>(n, 0, d);
+    cheb_update<T>(n, 0, T(1 / theta), w.dinv.data(), r, d, x);
   }
   real rho = 1 / sigma;
   for (int k = 1; k < opt_.degree; ++k) {
-    lv.A.residual(lv.bp, x, r);
+    residual<T>(l, w.bp, x, r);
     const real rho_new = 1 / (2 * sigma - rho);
-    cheb_update(n, rho_new * rho, 2 * rho_new / delta, lv.dinv.data(), r, d, x);
+    cheb_update<T>(n, T(rho_new * rho), T(2 * rho_new / delta), w.dinv.data(), r, d, x);
     rho = rho_new;
   }
 }
 
+template <class T>
 void Multigrid::vcycle(int l) const {
+  const Work<T>& w = work<T>()[l];
   const Level& lv = levels_[l];
   const index n = lv.A.size();
   if (l + 1 == int(levels_.size())) {
     ScopedTimer t(Kernel::coarse_solve);
-    for (index i = 0; i < n; ++i) cb_[i] = lv.bp[i];
+    for (index i = 0; i < n; ++i) cb_[i] = real(w.bp[i]);
     cx_ = coarse_.solve(cb_);
-    for (index i = 0; i < n; ++i) lv.xp[i] = cx_[i];
+    for (index i = 0; i < n; ++i) w.xp[i] = T(cx_[i]);
     return;
   }
-  const Level& c = levels_[l + 1];
-  smooth(l, true);
-  lv.A.residual(lv.bp, lv.xp, lv.r.data());
+  const Work<T>& c = work<T>()[l + 1];
+  const GridDims& cg = levels_[l + 1].A.grid();
+  smooth<T>(l, true);
+  residual<T>(l, w.bp, w.xp, w.r.data());
   {
     const double nf = double(n);
-    ScopedTimer t(Kernel::restrict_, nf * kRestrictCost);
-    restrict_to_coarse(lv.to_coarse, 3, lv.r.data(), c.b.data());
-    zero_constrained(c.A.grid(), c.A.faces(), c.b.data());
+    ScopedTimer t(Kernel::restrict_, nf * in_precision<T>(kRestrictCost));
+    restrict_to_coarse<T>(lv.to_coarse, 3, w.r.data(), c.b.data());
+    zero_constrained<T>(cg, lv.A.faces(), c.b.data());
   }
-  vcycle(l + 1);
+  vcycle<T>(l + 1);
   {
     // x += P x_c; the correction vanishes on constrained faces (they are
     // interpolated from constrained coarse nodes only), the mask makes it exact
     const double nf = double(n);
-    ScopedTimer t(Kernel::prolongate, nf * kProlongateCost);
-    prolongate(lv.to_coarse, 3, c.x.data(), lv.xp, true);
-    zero_constrained(lv.A.grid(), lv.A.faces(), lv.xp);
+    ScopedTimer t(Kernel::prolongate, nf * in_precision<T>(kProlongateCost));
+    prolongate<T>(lv.to_coarse, 3, c.x.data(), w.xp, true);
+    zero_constrained<T>(lv.A.grid(), lv.A.faces(), w.xp);
   }
-  smooth(l, false);
+  smooth<T>(l, false);
 }
 
 void Multigrid::apply(const real* r, real* z) const {
-  levels_[0].bp = r;
-  levels_[0].xp = z;
-  vcycle(0);
+  const index n = size();
+  if (opt_.precision == Precision::double_precision) {
+    work_d_[0].bp = r;
+    work_d_[0].xp = z;
+    vcycle<double>(0);
+  } else {
+    const Work<float>& w = work_s_[0];
+    convert<float>(n, r, w.b.data());
+    vcycle<float>(0);
+    convert<double>(n, w.x.data(), z);
+  }
 }
 
 std::string Multigrid::describe() const {
@@ -209,6 +279,7 @@ std::string Multigrid::describe() const {
     const GridDims& g = lv.A.grid();
     os << " " << g.ex << "x" << g.ey << "x" << g.ez;
   }
+  os << " (" << to_string(opt_.precision) << " precision)";
   return os.str();
 }
 

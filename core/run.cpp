@@ -8,7 +8,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   RunResult R;
   const double t0 = wall_time();
   R.problem = std::make_unique<Problem>(make_problem(spec));
-  SteklovPoincare S(*R.problem);
+  SteklovPoincare S(*R.problem, opt.mg);
   const double t1 = wall_time();
   if (opt.phase_done) opt.phase_done("setup (mesh, operators, multigrid)", t1 - t0);
   const std::vector<real> btilde = S.condensed_load(opt.tight_rtol);

@@ -14,6 +14,7 @@ namespace tresca {
 
 struct RunOptions {
   NewtonOptions newton;
+  MGOptions mg;  // both V-cycles: the inner K_ii solve and the Newton-step preconditioner
   // called after each phase with its name and duration (progress on long runs)
   std::function<void(const char* phase, double seconds)> phase_done;
   bool recover_interior = true;  // full 3D displacement (needed for VTK output)

@@ -110,7 +110,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   ReducedSystem L(n3);
   std::vector<real>& rhs = L.rhs;
   std::unique_ptr<BoundaryPreconditioner> M;
-  if (opt.outer_pc == OuterPreconditioner::multigrid) M = std::make_unique<BoundaryPreconditioner>(S);
+  if (opt.outer_pc == OuterPreconditioner::multigrid)
+    M = std::make_unique<BoundaryPreconditioner>(S, S.interior_multigrid().options());
   ReducedNewtonOperator A(S, L.h, L.free);
   CGWorkspace ws;
   real best = INFINITY;

@@ -58,7 +58,7 @@ void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
     if (src)
       copy(plane, src + a * N + iz * plane, dst);
     else
-      fill(plane, 0, dst);
+      fill<real>(plane, 0, dst);
   }
 }
 
@@ -110,7 +110,7 @@ std::vector<real> SteklovPoincare::recover(const real* uc, real rtol) const {
   solve_interior(t_.data(), u.data());
   inner_rtol_ = keep;
   set_plane(u.data(), 0, w_.data());
-  fill(n, 0, t_.data());
+  fill<real>(n, 0, t_.data());
   return u;
 }
 

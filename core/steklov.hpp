@@ -43,7 +43,7 @@ class SteklovPoincare : public LinearOperator {
   void set_inner_rtol(real r) const { inner_rtol_ = r; }
   real inner_rtol() const { return inner_rtol_; }
   const InnerStats& stats() const { return stats_; }
-  const Multigrid& interior_multigrid() const { return mg_; }
+  const Multigrid& interior_multigrid() const { return mg_; }  // its options() also serve the Newton step
   const ElasticityOperator& K() const { return K_; }
   const Problem& problem() const { return P_; }
 

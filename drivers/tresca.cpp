@@ -26,6 +26,8 @@ const char* kHelp =
     "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
     "  --max-newton N     Newton iteration limit (default 50)\n"
     "  --outer-pc mg|none preconditioner of the boundary Newton system (default mg)\n"
+    "  --mg-precision single|double  arithmetic of the multigrid V-cycles (default single;\n"
+    "                     the Krylov solvers and all results are double either way)\n"
     "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
     "  --json FILE        write the run summary as one JSON object (rows with --table)\n"
     "  --contact-csv FILE one row per contact node\n"
@@ -55,7 +57,8 @@ const PaperRow* paper_row(int level) {
   return nullptr;
 }
 
-std::string summary_json(const ProblemSpec& spec, const RunResult& R, int threads, double eps) {
+std::string summary_json(const ProblemSpec& spec, const RunResult& R, int threads, const RunOptions& opt) {
+  const double eps = opt.newton.eps;
   const Problem& P = *R.problem;
   const FinalReport& F = R.report;
   const NewtonResult& N = R.newton;
@@ -79,7 +82,8 @@ std::string summary_json(const ProblemSpec& spec, const RunResult& R, int thread
     j.null("level");
   j.raw("dims", "[" + std::to_string(spec.ex) + ", " + std::to_string(spec.ey) + ", " + std::to_string(spec.ez) + "]")
       .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
-      .num("phi", spec.phi).num("eps", eps).integer("threads", threads).str("build", build_info()).integer("newton_iterations", N.iterations)
+      .num("phi", spec.phi).num("eps", eps).integer("threads", threads).str("build", build_info())
+      .str("mg_precision", to_string(opt.mg.precision)).integer("newton_iterations", N.iterations)
       .boolean("converged", N.converged()).str("reason", to_string(N.reason))
       .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())
       .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
@@ -99,7 +103,7 @@ int main(int argc, char** argv) {
   try {
     const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table", "--outer-pc"},
+                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision"},
                   {"--quiet", "--help", "--profile"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
@@ -118,6 +122,10 @@ int main(int argc, char** argv) {
     const std::string pc = a.str("--outer-pc", "mg");
     if (pc != "mg" && pc != "none") throw std::invalid_argument("--outer-pc '" + pc + "' must be mg or none");
     opt.newton.outer_pc = pc == "mg" ? OuterPreconditioner::multigrid : OuterPreconditioner::none;
+    const std::string prec = a.str("--mg-precision", "single");
+    if (prec != "single" && prec != "double")
+      throw std::invalid_argument("--mg-precision '" + prec + "' must be single or double");
+    opt.mg.precision = prec == "single" ? Precision::single_precision : Precision::double_precision;
     quiet = a.has("--quiet");
     profile = a.has("--profile");
     json_path = a.str("--json");
@@ -177,7 +185,7 @@ int main(int argc, char** argv) {
                     R.report.true_residual, R.report.true_residual_relative);
         std::fflush(stdout);
         all = all && R.newton.converged();
-        rows += (rows.size() > 1 ? ",\n " : "") + summary_json(s, R, threads, opt.newton.eps);
+        rows += (rows.size() > 1 ? ",\n " : "") + summary_json(s, R, threads, opt);
       }
       if (!json_path.empty()) write_file_atomic(json_path, rows + "]\n");
       return all ? 0 : 1;
@@ -220,7 +228,7 @@ int main(int argc, char** argv) {
                              profile_table(R.times.total).c_str());
     try {
       const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status};
-      if (!json_path.empty()) write_file_atomic(json_path, summary_json(spec, R, threads, opt.newton.eps) + "\n");
+      if (!json_path.empty()) write_file_atomic(json_path, summary_json(spec, R, threads, opt) + "\n");
       if (!csv_path.empty()) write_contact_csv(csv_path, *R.problem, cf);
       if (!vtk_path.empty()) {
         const std::string second = write_vtu(vtk_path, *R.problem, R.u_full, cf);

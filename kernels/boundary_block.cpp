@@ -2,17 +2,21 @@
 
 namespace tresca {
 
-void bottom_block_apply(const GridDims& g, real alpha, const real* B, const real* x, real* y) {
+template <class T>
+void bottom_block_apply(const GridDims& g, T alpha, const T* B, const T* x, T* y) {
   const index M = g.nx() * g.ny(), N = g.nodes();
-  const real *bxx = B, *bxy = B + M, *byy = B + 2 * M, *bzz = B + 3 * M;
+  const T *bxx = B, *bxy = B + M, *byy = B + 2 * M, *bzz = B + 3 * M;
 #pragma omp parallel for simd schedule(static) if (M > 4096)
   for (index n = 0; n < M; ++n) {
-    const real ux = x[n], uy = x[N + n], uz = x[2 * N + n];
+    const T ux = x[n], uy = x[N + n], uz = x[2 * N + n];
     y[n] += alpha * (bxx[n] * ux + bxy[n] * uy);
     y[N + n] += alpha * (bxy[n] * ux + byy[n] * uy);
     y[2 * N + n] += alpha * bzz[n] * uz;
   }
 }
+
+template void bottom_block_apply<double>(const GridDims&, double, const double*, const double*, double*);
+template void bottom_block_apply<float>(const GridDims&, float, const float*, const float*, float*);
 
 void bottom_block_apply_ref(const GridDims& g, real alpha, const real* B, const real* x, real* y) {
   const index M = g.nx() * g.ny(), N = g.nodes();

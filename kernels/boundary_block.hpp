@@ -13,7 +13,9 @@ namespace tresca {
 
 constexpr Cost kBottomBlockCost{104, 13};  // per bottom-face node
 
-void bottom_block_apply(const GridDims& g, real alpha, const real* B, const real* x, real* y);
+// T = double or float (B, x, y all of T); the _ref twin is double only.
+template <class T>
+void bottom_block_apply(const GridDims& g, T alpha, const T* B, const T* x, T* y);
 void bottom_block_apply_ref(const GridDims& g, real alpha, const real* B, const real* x, real* y);
 
 }  // namespace tresca

@@ -29,16 +29,16 @@ std::uint8_t axis_class(index i, index n, bool c_lo, bool c_hi) {
 bool dropped(std::uint8_t c, int d) { return (d < 0 && (c & kDropL)) || (d > 0 && (c & kDropR)); }
 
 // Accumulates the groups [g, ge) whose nonzero outputs are the mask M.
-// V is the target's native vector of kLanes doubles (simd.hpp); each input
-// vector is loaded once and feeds the |M| outputs.
-constexpr int kLanes = Simd<real>::lanes;
-using V = Vec<real>;
-
-template <int NV, int M>
-inline void accumulate(const StencilGroup* g, const StencilGroup* ge, const real* x, V* a0, V* a1, V* a2) {
+// V is the target's native vector of Simd<T>::lanes values of T (simd.hpp);
+// each input vector is loaded once and feeds the |M| outputs.
+template <class T, int NV, int M>
+inline void accumulate(const StencilGroupT<T>* g, const StencilGroupT<T>* ge, const T* x, Vec<T>* a0, Vec<T>* a1,
+                       Vec<T>* a2) {
+  using V = Vec<T>;
+  constexpr int kLanes = Simd<T>::lanes;
   for (; g != ge; ++g) {
-    const real* xp = x + g->off;
-    const real c0 = g->c[0], c1 = g->c[1], c2 = g->c[2];
+    const T* xp = x + g->off;
+    const T c0 = g->c[0], c1 = g->c[1], c2 = g->c[2];
     V v[NV];
     for (int l = 0; l < NV; ++l) v[l] = *reinterpret_cast<const V*>(xp + kLanes * l);
     for (int l = 0; l < NV; ++l) {
@@ -50,14 +50,16 @@ inline void accumulate(const StencilGroup* g, const StencilGroup* ge, const real
 }
 
 // y_a[i..i+W) for the 3 output components of one stencil; f = first + 7*s.
-template <int W>
-inline void stencil_block(const StencilGroup* g, const std::int32_t* f, const real* x, real* y, const real* b,
-                          index N, index i) {
+template <class T, int W>
+inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, const T* x, T* y, const T* b, index N,
+                          index i) {
+  using V = Vec<T>;
+  constexpr int kLanes = Simd<T>::lanes;
   if constexpr (W % kLanes != 0) {
     // scalar path for runs shorter than one vector
     for (int l = 0; l < W; ++l) {
-      real acc[3] = {0, 0, 0};
-      for (const StencilGroup* q = g + f[0]; q != g + f[7]; ++q)
+      T acc[3] = {0, 0, 0};
+      for (const StencilGroupT<T>* q = g + f[0]; q != g + f[7]; ++q)
         for (int a = 0; a < 3; ++a) acc[a] += q->c[a] * x[i + l + q->off];
       for (int a = 0; a < 3; ++a) y[a * N + i + l] = b ? b[a * N + i + l] - acc[a] : acc[a];
     }
@@ -66,13 +68,13 @@ inline void stencil_block(const StencilGroup* g, const std::int32_t* f, const re
     V a0[NV], a1[NV], a2[NV];
     for (int l = 0; l < NV; ++l) a0[l] = a1[l] = a2[l] = V{};
     x += i;
-    accumulate<NV, 1>(g + f[0], g + f[1], x, a0, a1, a2);
-    accumulate<NV, 2>(g + f[1], g + f[2], x, a0, a1, a2);
-    accumulate<NV, 3>(g + f[2], g + f[3], x, a0, a1, a2);
-    accumulate<NV, 4>(g + f[3], g + f[4], x, a0, a1, a2);
-    accumulate<NV, 5>(g + f[4], g + f[5], x, a0, a1, a2);
-    accumulate<NV, 6>(g + f[5], g + f[6], x, a0, a1, a2);
-    accumulate<NV, 7>(g + f[6], g + f[7], x, a0, a1, a2);
+    accumulate<T, NV, 1>(g + f[0], g + f[1], x, a0, a1, a2);
+    accumulate<T, NV, 2>(g + f[1], g + f[2], x, a0, a1, a2);
+    accumulate<T, NV, 3>(g + f[2], g + f[3], x, a0, a1, a2);
+    accumulate<T, NV, 4>(g + f[3], g + f[4], x, a0, a1, a2);
+    accumulate<T, NV, 5>(g + f[4], g + f[5], x, a0, a1, a2);
+    accumulate<T, NV, 6>(g + f[5], g + f[6], x, a0, a1, a2);
+    accumulate<T, NV, 7>(g + f[6], g + f[7], x, a0, a1, a2);
     V* out[3] = {a0, a1, a2};
     for (int a = 0; a < 3; ++a)
       for (int l = 0; l < NV; ++l) {
@@ -82,21 +84,23 @@ inline void stencil_block(const StencilGroup* g, const std::int32_t* f, const re
   }
 }
 
-inline void stencil_range(const StencilGroup* g, const std::int32_t* f, const real* x, real* y, const real* b,
-                          index N, index i0, index i1) {
+template <class T>
+inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* x, T* y, const T* b, index N,
+                          index i0, index i1) {
+  constexpr int kLanes = Simd<T>::lanes;
   // three vectors per block: 9 accumulators + 3 inputs fit the 16 registers of
   // SSE/AVX2 (and AVX-512's 32); measured best of 1..4 on AVX-512, AVX2 and
   // SSE4.2 builds alike (perf/RESULTS.md)
   constexpr int kW = 3 * kLanes;
   index i = i0;
-  for (; i + kW <= i1; i += kW) stencil_block<kW>(g, f, x, y, b, N, i);
-  for (; i + kLanes <= i1; i += kLanes) stencil_block<kLanes>(g, f, x, y, b, N, i);
+  for (; i + kW <= i1; i += kW) stencil_block<T, kW>(g, f, x, y, b, N, i);
+  for (; i + kLanes <= i1; i += kLanes) stencil_block<T, kLanes>(g, f, x, y, b, N, i);
   if (i < i1 && i1 - i0 >= kLanes) {
     // finish with one overlapping vector: recomputes a few outputs of the same run
-    stencil_block<kLanes>(g, f, x, y, b, N, i1 - kLanes);
+    stencil_block<T, kLanes>(g, f, x, y, b, N, i1 - kLanes);
     return;
   }
-  for (; i < i1; ++i) stencil_block<1>(g, f, x, y, b, N, i);
+  for (; i < i1; ++i) stencil_block<T, 1>(g, f, x, y, b, N, i);
 }
 
 }  // namespace
@@ -180,8 +184,27 @@ ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, re
   return k;
 }
 
-void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
-                      const real* b) {
+template <class T>
+ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& k) {
+  ElasticityStencilT<T> t;
+  t.g = k.g;
+  t.faces = k.faces;
+  t.E = k.E;
+  t.nu = k.nu;
+  t.Ke = k.Ke;
+  for (int a = 0; a < 3; ++a) t.cls[a] = k.cls[a];
+  t.run_begin = k.run_begin;
+  t.slot = k.slot;
+  t.first = k.first;
+  for (const StencilGroup& q : k.groups) t.groups.push_back({q.off, {T(q.c[0]), T(q.c[1]), T(q.c[2])}});
+  for (real c : k.center) t.center.push_back(T(c));
+  return t;
+}
+template ElasticityStencilT<float> stencil_in_precision<float>(const ElasticityStencil&);
+template ElasticityStencilT<double> stencil_in_precision<double>(const ElasticityStencil&);
+
+template <class T>
+void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_begin, index z_end, const T* b) {
   const GridDims& g = k.g;
   const index nx = g.nx(), ny = g.ny(), N = g.nodes();
   const index nruns = index(k.run_begin.size()) - 1;
@@ -210,10 +233,14 @@ void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index 
             continue;
           }
           const std::int32_t s = k.slot[(cx * 32 + cy) * 32 + cz];
-          stencil_range(k.groups.data(), k.first.data() + 7 * s, x + row, y + row, b ? b + row : nullptr, N, i0, i1);
+          stencil_range<T>(k.groups.data(), k.first.data() + 7 * s, x + row, y + row, b ? b + row : nullptr, N, i0, i1);
         }
       }
 }
+template void elasticity_apply<double>(const ElasticityStencilT<double>&, const double*, double*, index, index,
+                                       const double*);
+template void elasticity_apply<float>(const ElasticityStencilT<float>&, const float*, float*, index, index,
+                                      const float*);
 
 void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
                           const real* b) {
@@ -288,11 +315,12 @@ void elasticity_diagonal_ref(const ElasticityStencil& k, real* d) {
           for (int a = 0; a < 3; ++a) d[a * N + g.node(ix, iy, iz)] = 1;
 }
 
-void zero_constrained(const GridDims& g, unsigned faces, real* v) {
+template <class T>
+void zero_constrained(const GridDims& g, unsigned faces, T* v) {
   // touches only the constrained faces: O(surface), not O(volume)
   const index nx = g.nx(), ny = g.ny(), nz = g.nz(), N = g.nodes();
   for (int a = 0; a < 3; ++a) {
-    real* c = v + a * N;
+    T* c = v + a * N;
     if (faces & (kFaceZ0 | kFaceZ1))
       for (index iz : {index(0), nz - 1})
         if ((iz == 0 && (faces & kFaceZ0)) || (iz == nz - 1 && (faces & kFaceZ1)))
@@ -310,5 +338,8 @@ void zero_constrained(const GridDims& g, unsigned faces, real* v) {
     }
   }
 }
+
+template void zero_constrained<double>(const GridDims&, unsigned, double*);
+template void zero_constrained<float>(const GridDims&, unsigned, float*);
 
 }  // namespace tresca

@@ -32,12 +32,16 @@
 
 namespace tresca {
 
-struct StencilGroup {
+template <class T>
+struct StencilGroupT {
   index off;  // b*N + dx + nx*(dy + ny*dz): input offset relative to the output node
-  real c[3];  // couplings K[(p,a),(p+d,b)] for output components a = 0,1,2
+  T c[3];     // couplings K[(p,a),(p+d,b)] for output components a = 0,1,2
 };
 
-struct ElasticityStencil {
+// The stencils of one grid with coefficients of type T (double; float for the
+// single-precision multigrid V-cycle, made by stencil_in_precision).
+template <class T>
+struct ElasticityStencilT {
   GridDims g;
   unsigned faces = 0;       // constrained faces (bitmask of Face)
   real E = 0, nu = 0;
@@ -53,27 +57,35 @@ struct ElasticityStencil {
   // nonzero outputs form mask m (1..7) are groups[first[7*s+m-1] .. first[7*s+m])
   std::vector<std::int32_t> slot;
   std::vector<std::int32_t> first;
-  std::vector<StencilGroup> groups;
-  std::vector<real> center;  // diagonal coefficient per stencil and component: center[3*s+a]
+  std::vector<StencilGroupT<T>> groups;
+  std::vector<T> center;  // diagonal coefficient per stencil and component: center[3*s+a]
 
   index nodes() const { return g.nodes(); }
   index size() const { return 3 * g.nodes(); }
 };
+using ElasticityStencil = ElasticityStencilT<real>;
+using StencilGroup = StencilGroupT<real>;
 
 // Builds Ke and all stencils needed by grid g with constrained faces.
 ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, real E, real nu);
+// The same stencils with coefficients rounded to T.
+template <class T>
+ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& k);
+
+// Cost per output node (double fields; in_precision<float> halves the bytes):
+// y = K x reads x and writes y (3 components each; neighbour rows come from
+// cache), 153 FMAs; the residual b - K x also reads b.
+constexpr Cost kApplyCost{48, 306};
+constexpr Cost kResidualCost{72, 309};
 
 // y = K x for output planes iz in [z_begin, z_end) (the whole grid with
 // z_begin = 0, z_end = g.nz()). With b != nullptr the residual y = b - K x is
 // written instead (fused: one extra input stream, no extra pass). OpenMP over
-// x-rows.
-// per output node: y = K x reads x and writes y (3 components each; neighbour
-// rows come from cache), 153 FMAs; the residual b - K x also reads b.
-constexpr Cost kApplyCost{48, 306};
-constexpr Cost kResidualCost{72, 309};
-
-void elasticity_apply(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
-                      const real* b = nullptr);
+// x-rows. Instantiated for T = double and float (vectors of Simd<T>::lanes);
+// the _ref twin is double only.
+template <class T>
+void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_begin, index z_end,
+                      const T* b = nullptr);
 void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
                           const real* b = nullptr);
 
@@ -81,7 +93,8 @@ void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, in
 void elasticity_diagonal(const ElasticityStencil& k, real* d);
 void elasticity_diagonal_ref(const ElasticityStencil& k, real* d);
 
-// v = 0 on the constrained faces (all components).
-void zero_constrained(const GridDims& g, unsigned faces, real* v);
+// v = 0 on the constrained faces (all components); T = double or float.
+template <class T>
+void zero_constrained(const GridDims& g, unsigned faces, T* v);
 
 }  // namespace tresca

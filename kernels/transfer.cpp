@@ -47,7 +47,8 @@ Transfer build_transfer(const GridDims& fine, const GridDims& coarse) {
   return t;
 }
 
-void prolongate(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate) {
+template <class T>
+void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool accumulate) {
   const GridDims &f = t.fine, &c = t.coarse;
   const index Nf = f.nodes(), Nc = c.nodes();
   const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
@@ -55,24 +56,27 @@ void prolongate(const Transfer& t, int comps, const real* coarse, real* fine, bo
   for (index iz = 0; iz < f.nz(); ++iz)
     for (index iy = 0; iy < f.ny(); ++iy) {
       const index jz = Z.j0[iz], jy = Y.j0[iy];
-      const real wz = Z.w[iz], wy = Y.w[iy];
-      const real w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
+      const T wz = T(Z.w[iz]), wy = T(Y.w[iy]);
+      const T w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
       const index cnx = c.nx(), cny = c.ny();
       const index b00 = cnx * (jy + cny * jz), b10 = b00 + cnx, b01 = b00 + cnx * cny, b11 = b01 + cnx;
       for (int a = 0; a < comps; ++a) {
-        const real* u = coarse + a * Nc;
-        real* v = fine + a * Nf + f.nx() * (iy + f.ny() * iz);
+        const T* u = coarse + a * Nc;
+        T* v = fine + a * Nf + f.nx() * (iy + f.ny() * iz);
         for (index ix = 0; ix < f.nx(); ++ix) {
           const index j = X.j0[ix];
-          const real wx = X.w[ix];
-          const real s0 = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
-          const real s1 =
+          const T wx = T(X.w[ix]);
+          const T s0 = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
+          const T s1 =
               w00 * u[b00 + j + 1] + w10 * u[b10 + j + 1] + w01 * u[b01 + j + 1] + w11 * u[b11 + j + 1];
           v[ix] = (accumulate ? v[ix] : 0) + (1 - wx) * s0 + wx * s1;
         }
       }
     }
 }
+
+template void prolongate<double>(const Transfer&, int, const double*, double*, bool);
+template void prolongate<float>(const Transfer&, int, const float*, float*, bool);
 
 void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate) {
   const GridDims &f = t.fine, &c = t.coarse;
@@ -94,7 +98,8 @@ void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine
         }
 }
 
-void restrict_to_coarse(const Transfer& t, int comps, const real* fine, real* coarse) {
+template <class T>
+void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) {
   // Per coarse row (jy, jz): sum the weighted fine rows of its y/z support
   // into one row buffer (contiguous, vectorisable), then gather along x.
   const GridDims &f = t.fine, &c = t.coarse;
@@ -102,29 +107,32 @@ void restrict_to_coarse(const Transfer& t, int comps, const real* fine, real* co
   const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
 #pragma omp parallel
   {
-    std::vector<real> row(fnx);  // one buffer per thread, allocated once per call
+    std::vector<T> row(fnx);  // one buffer per thread, allocated once per call
 #pragma omp for collapse(2) schedule(static)
     for (index jz = 0; jz < c.nz(); ++jz)
       for (index jy = 0; jy < c.ny(); ++jy)
         for (int a = 0; a < comps; ++a) {
-          real* acc = row.data();
+          T* acc = row.data();
           for (index i = 0; i < fnx; ++i) acc[i] = 0;
           for (index kz = Z.tstart[jz]; kz < Z.tstart[jz + 1]; ++kz)
             for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky) {
-              const real w = Z.tw[kz] * Y.tw[ky];
-              const real* rr = fine + a * Nf + fnx * (Y.tf[ky] + f.ny() * Z.tf[kz]);
+              const T w = T(Z.tw[kz] * Y.tw[ky]);
+              const T* rr = fine + a * Nf + fnx * (Y.tf[ky] + f.ny() * Z.tf[kz]);
 #pragma omp simd
               for (index i = 0; i < fnx; ++i) acc[i] += w * rr[i];
             }
-          real* out = coarse + a * Nc + c.nx() * (jy + c.ny() * jz);
+          T* out = coarse + a * Nc + c.nx() * (jy + c.ny() * jz);
           for (index jx = 0; jx < c.nx(); ++jx) {
-            real sx = 0;
-            for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += X.tw[kx] * acc[X.tf[kx]];
+            T sx = 0;
+            for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += T(X.tw[kx]) * acc[X.tf[kx]];
             out[jx] = sx;
           }
         }
   }
 }
+
+template void restrict_to_coarse<double>(const Transfer&, int, const double*, double*);
+template void restrict_to_coarse<float>(const Transfer&, int, const float*, float*);
 
 void restrict_to_coarse_ref(const Transfer& t, int comps, const real* fine, real* coarse) {
   const GridDims &f = t.fine, &c = t.coarse;

@@ -45,11 +45,14 @@ struct Transfer {
 
 Transfer build_transfer(const GridDims& fine, const GridDims& coarse);
 
-// fine = P coarse (or fine += P coarse with accumulate), for `comps` components
-void prolongate(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate = false);
+// fine = P coarse (or fine += P coarse with accumulate), for `comps` components.
+// The optimised kernels are instantiated for T = double and float.
+template <class T>
+void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool accumulate = false);
 void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate = false);
 // coarse = P^T fine
-void restrict_to_coarse(const Transfer& t, int comps, const real* fine, real* coarse);
+template <class T>
+void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse);
 void restrict_to_coarse_ref(const Transfer& t, int comps, const real* fine, real* coarse);
 
 }  // namespace tresca

@@ -15,4 +15,9 @@ struct Cost {
 };
 constexpr Cost operator*(double n, Cost c) { return {n * c.bytes, n * c.flops}; }
 constexpr Cost operator+(Cost a, Cost b) { return {a.bytes + b.bytes, a.flops + b.flops}; }
+// the cost models are stated for double fields; fields of T move sizeof(T)/8 of the bytes
+template <class T>
+constexpr Cost in_precision(Cost c) {
+  return {c.bytes * double(sizeof(T)) / double(sizeof(real)), c.flops};
+}
 }  // namespace tresca

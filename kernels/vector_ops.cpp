@@ -82,7 +82,8 @@ void copy(index n, const real* x, real* y) {
 #pragma omp parallel for simd schedule(static)
   for (index i = 0; i < n; ++i) y[i] = x[i];
 }
-void fill(index n, real v, real* y) {
+template <class T>
+void fill(index n, T v, T* y) {
 #pragma omp parallel for simd schedule(static)
   for (index i = 0; i < n; ++i) y[i] = v;
 }
@@ -124,7 +125,14 @@ real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real*
   return dot_ref(n, r, r);
 }
 
-void cheb_update(index n, real s, real t, const real* dinv, const real* r, real* d, real* x) {
+template <class To, class From>
+void convert(index n, const From* x, To* y) {
+#pragma omp parallel for simd schedule(static)
+  for (index i = 0; i < n; ++i) y[i] = To(x[i]);
+}
+
+template <class T>
+void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x) {
 #pragma omp parallel for simd schedule(static)
   for (index i = 0; i < n; ++i) {
     d[i] = s * d[i] + t * dinv[i] * r[i];
@@ -132,10 +140,20 @@ void cheb_update(index n, real s, real t, const real* dinv, const real* r, real*
   }
 }
 
-void cheb_first(index n, real t, const real* dinv, const real* b, real* d, real* x) {
+template <class T>
+void cheb_first(index n, T t, const T* dinv, const T* b, T* d, T* x) {
 #pragma omp parallel for simd schedule(static)
   for (index i = 0; i < n; ++i) x[i] = d[i] = t * dinv[i] * b[i];
 }
+
+template void fill<double>(index, double, double*);
+template void fill<float>(index, float, float*);
+template void convert<float, double>(index, const double*, float*);
+template void convert<double, float>(index, const float*, double*);
+template void cheb_update<double>(index, double, double, const double*, const double*, double*, double*);
+template void cheb_update<float>(index, float, float, const float*, const float*, float*, float*);
+template void cheb_first<double>(index, double, const double*, const double*, double*, double*);
+template void cheb_first<float>(index, float, const float*, const float*, float*, float*);
 
 
 }  // namespace tresca

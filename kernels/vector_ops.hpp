@@ -9,6 +9,7 @@
 //   cg_update (x += a p, r -= a q, returns r.r) 48n B, 6n F;
 //   cheb_update (d = s d + t Dinv r, x += d) 40n B, 5n F;
 //   cheb_first (d = t Dinv b, x = d) 32n B, 2n F.
+// (Fields of float move half the bytes: in_precision<float>, types.hpp.)
 #pragma once
 #include "types.hpp"
 
@@ -25,15 +26,20 @@ real norm2(index n, const real* x);
 void axpy(index n, real a, const real* x, real* y);        // y += a x
 void xpay(index n, const real* x, real a, real* y);        // y = x + a y
 void copy(index n, const real* x, real* y);                // y = x
-void fill(index n, real v, real* y);                       // y = v
+template <class T>
+void fill(index n, T v, T* y);                             // y = v (T = double, float)
+template <class To, class From>
+void convert(index n, const From* x, To* y);               // y = To(x) (double <-> float)
 void scale(index n, real a, real* y);                      // y *= a
 void hadamard(index n, const real* d, const real* x, real* y);  // y = d .* x
 // x += a p; r -= a q; returns r.r
 real cg_update(index n, real a, const real* p, const real* q, real* x, real* r);
 real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real* r);
-// d = s d + t dinv .* r; x += d
-void cheb_update(index n, real s, real t, const real* dinv, const real* r, real* d, real* x);
+// d = s d + t dinv .* r; x += d   (T = double, float)
+template <class T>
+void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x);
 // first Chebyshev step from x = 0: d = t dinv .* b; x = d
-void cheb_first(index n, real t, const real* dinv, const real* b, real* d, real* x);
+template <class T>
+void cheb_first(index n, T t, const T* dinv, const T* b, T* d, T* x);
 
 }  // namespace tresca

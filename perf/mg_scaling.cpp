@@ -14,11 +14,16 @@ using namespace tresca;
 
 int main(int argc, char** argv) {
   try {
-    Args a(argc, argv, {"--levels", "--rtol", "--threads", "--json"}, {"--help"});
+    Args a(argc, argv, {"--levels", "--rtol", "--threads", "--json", "--precision"}, {"--help"});
     if (a.has("--help")) {
-      std::puts("usage: mg_scaling [--levels 3-11] [--rtol 1e-10] [--threads N] [--json FILE]");
+      std::puts("usage: mg_scaling [--levels 3-11] [--rtol 1e-10] [--threads N] [--precision single|double] [--json FILE]");
       return 0;
     }
+    MGOptions mo;
+    const std::string prec = a.str("--precision", "single");
+    if (prec != "single" && prec != "double")
+      throw std::invalid_argument("--precision '" + prec + "' must be single or double");
+    mo.precision = prec == "single" ? Precision::single_precision : Precision::double_precision;
     const int threads = apply_threads(a);
     const auto levels = parse_level_range(a.str("--levels", "3-11"));
     const real rtol = a.real_value("--rtol", 1e-10);
@@ -27,25 +32,26 @@ int main(int argc, char** argv) {
     if (!json.empty()) check_writable(json);
     for (int L : levels) check_memory(spec_for_level(L));
     std::printf("# kernels: %s, %d threads\n", build_info().c_str(), threads);
-    std::printf("%5s %11s %-52s %6s %9s %9s %11s %s\n", "level", "dofs", "hierarchy", "iters", "setup[s]", "solve[s]",
+    std::printf("%5s %11s %-70s %6s %9s %9s %11s %s\n", "level", "dofs", "hierarchy", "iters", "setup[s]", "solve[s]",
                 "s/iter", "rel.res (recomputed)");
     std::string rows = "[";
     for (int L : levels) {
       const Problem P = make_problem(spec_for_level(L));
       const double t0 = wall_time();
-      Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+      Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
       const double t1 = wall_time();
       const InteriorSolution sol = solve_interior_elasticity(P, mg, rtol);
       const SolveStats& st = sol.stats;
       const double solve = sol.seconds, rel = sol.relative_residual;
-      std::printf("%5d %11lld %-52s %6d %9.3f %9.3f %11.4f %.2e %s\n", L, (long long)P.dofs(), mg.describe().c_str(),
+      std::printf("%5d %11lld %-70s %6d %9.3f %9.3f %11.4f %.2e %s\n", L, (long long)P.dofs(), mg.describe().c_str(),
                   st.iterations, t1 - t0, solve, solve / std::max(1, st.iterations), rel,
                   st.ok() ? "" : to_string(st.reason));
       std::fflush(stdout);
       Json j;
       j.integer("level", L).integer("dofs", P.dofs()).integer("levels", mg.num_levels())
           .integer("iterations", st.iterations).num("setup", t1 - t0).num("solve", solve)
-          .num("relative_residual", rel).str("reason", to_string(st.reason)).integer("threads", threads).str("build", build_info());
+          .num("relative_residual", rel).str("reason", to_string(st.reason)).integer("threads", threads).str("build", build_info())
+          .str("precision", to_string(mo.precision));
       rows += (rows.size() > 1 ? ",\n " : "") + j.render();
     }
     if (!json.empty()) write_file_atomic(json, rows + "]\n");

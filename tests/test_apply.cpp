@@ -72,6 +72,29 @@ TEST(ElasticityApply, OptimisedEqualsReferenceIncludingPlaneRanges) {
     }
 }
 
+TEST(ElasticityApply, SinglePrecisionMatchesReferenceToFloatRounding) {
+  for (auto& s : kSizes)
+    for (unsigned faces : kFaceSets) {
+      const GridDims g = test::prism(s[0], s[1], s[2]);
+      const ElasticityStencil k = build_elasticity_stencil(g, faces, 2.1e9, 0.277);
+      const ElasticityStencilT<float> kf = stencil_in_precision<float>(k);
+      const auto x = random_vector(k.size(), 5), b = random_vector(k.size(), 6);
+      std::vector<float> xf(x.begin(), x.end()), bf(b.begin(), b.end()), yf(k.size()), rf(k.size());
+      // the reference on the float-rounded input, so only the kernel's rounding differs
+      const std::vector<real> xr(xf.begin(), xf.end()), br(bf.begin(), bf.end());
+      std::vector<real> yr(k.size()), rr(k.size());
+      elasticity_apply_ref(k, xr.data(), yr.data(), 0, g.nz());
+      elasticity_apply_ref(k, xr.data(), rr.data(), 0, g.nz(), br.data());
+      elasticity_apply<float>(kf, xf.data(), yf.data(), 0, g.nz());
+      elasticity_apply<float>(kf, xf.data(), rf.data(), 0, g.nz(), bf.data());
+      // 27-point sums of terms up to |Ke| |x|: float rounding ~ 1e-7 of the largest term
+      const real scale = max_abs(std::vector<real>(k.Ke.begin(), k.Ke.end())) * 27 * 3;
+      EXPECT_LT(max_abs_diff(std::vector<real>(yf.begin(), yf.end()), yr), 1e-6 * scale)
+          << s[0] << "x" << s[1] << "x" << s[2] << " faces " << faces;
+      EXPECT_LT(max_abs_diff(std::vector<real>(rf.begin(), rf.end()), rr), 1e-6 * scale);
+    }
+}
+
 TEST(ElasticityApply, IsSymmetric) {
   for (unsigned faces : kFaceSets) {
     ElasticityOperator A(test::prism(7, 3, 2), faces, 2.1e9, 0.277);

@@ -41,6 +41,50 @@ TEST(MultigridCG, MatchesSparseDirectSolveOnOddMeshes) {
   }
 }
 
+TEST(MultigridCG, SinglePrecisionVCycleKeepsIterationsAndAccuracy) {
+  // the V-cycle in float preconditions a double CG: same iteration count (+-1)
+  // and the same attainable accuracy as the double V-cycle, odd mesh included
+  for (int level : {5, 7})
+    for (bool odd : {false, true}) {
+      const Problem P = odd ? make_problem(spec_for_dims(23, 11, 13)) : make_problem(spec_for_level(level));
+      int its[2];
+      std::vector<real> u[2];
+      for (int k = 0; k < 2; ++k) {
+        MGOptions mo;
+        mo.precision = k ? Precision::single_precision : Precision::double_precision;
+        Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
+        const InteriorSolution sol = solve_interior_elasticity(P, mg, 1e-12);
+        ASSERT_TRUE(sol.stats.ok()) << to_string(sol.stats.reason);
+        EXPECT_LT(sol.relative_residual, 1e-12);
+        its[k] = sol.stats.iterations;
+        u[k] = sol.u;
+      }
+      EXPECT_LE(std::abs(its[1] - its[0]), 1) << "level " << level << (odd ? " (23x11x13)" : "");
+      EXPECT_LT(test::max_abs_diff(u[0], u[1]), 1e-10 * test::max_abs(u[0]));
+    }
+}
+
+TEST(MultigridVCycle, IsSymmetricInBothPrecisions) {
+  // CG needs a symmetric preconditioner: |x^T M y - y^T M x| small relative to
+  // |x||M y| (float rounding leaves ~1e-7 in single precision)
+  const Problem P = make_problem(spec_for_dims(13, 7, 9));
+  for (Precision prec : {Precision::double_precision, Precision::single_precision}) {
+    MGOptions mo;
+    mo.precision = prec;
+    mo.coarse_nodes = 60;
+    Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
+    auto x = test::random_vector(P.dofs(), 21), y = test::random_vector(P.dofs(), 22);
+    zero_constrained(P.grid, P.interior_faces, x.data());
+    zero_constrained(P.grid, P.interior_faces, y.data());
+    std::vector<real> Mx(P.dofs()), My(P.dofs());
+    mg.apply(x.data(), Mx.data());
+    mg.apply(y.data(), My.data());
+    const real a = dot(P.dofs(), x.data(), My.data()), b = dot(P.dofs(), y.data(), Mx.data());
+    const real scale = norm2(P.dofs(), x.data()) * norm2(P.dofs(), My.data());
+    EXPECT_LT(std::abs(a - b), (prec == Precision::single_precision ? 1e-5 : 1e-12) * scale) << to_string(prec);
+  }
+}
+
 TEST(MultigridCG, IterationCountIsMeshIndependent) {
   // coarse_nodes = 100 makes every one of these a genuine multilevel cycle
   int its[3];

@@ -11,6 +11,7 @@
 #include "core/report.hpp"
 #include "core/run.hpp"
 #include "dense_reference.hpp"
+#include "test_helpers.hpp"
 
 namespace tresca {
 
@@ -126,8 +127,13 @@ void compare_with_dense(index ex, index ey, index ez, real phi, bool expect_mixe
     EXPECT_NEAR(step.history[0], ref.history[k], 1e-8 * ref.history[k] + 1e-12 * ref.history[0]) << "k=" << k;
     real umax, lmax;
     const auto e = iterate_errors(step.u, step.lambda, ref.iterates[k + 1], umax, lmax);
-    EXPECT_LE(e.first, 1e-8 * umax) << "u after step " << k + 1;
-    EXPECT_LE(e.second, 1e-8 * lmax) << "lambda after step " << k + 1;
+    // Steps are inexact by design (outer CG to an absolute target, inner
+    // solves relaxed up to rtol 1e-2 as the outer residual falls). Measured
+    // worst step error over the three cases: 2.4e-9 with a double-precision
+    // V-cycle, 1.1e-8 with the single-precision one (the default); the final
+    // solutions below are held to 1e-8 either way.
+    EXPECT_LE(e.first, 2e-8 * umax) << "u after step " << k + 1;
+    EXPECT_LE(e.second, 2e-8 * lmax) << "lambda after step " << k + 1;
   }
   // (b) whole runs: same path where no node decision is marginal, same solution always
   if (same_path) {
@@ -167,6 +173,31 @@ TEST(SemismoothNewton, MatchesDenseReferenceAtPaperFriction) { compare_with_dens
 TEST(SemismoothNewton, MatchesDenseReferenceWithStickSlipAndSeparation) { compare_with_dense(8, 4, 4, 1e7, true, false); }
 
 TEST(SemismoothNewton, MatchesDenseReferenceOnOddMesh) { compare_with_dense(7, 3, 3, 3e6, false, false); }
+
+TEST(SemismoothNewton, SingleAndDoublePrecisionVCyclesGiveTheSameSolution) {
+  // the V-cycles only precondition double-precision Krylov solves: the
+  // answers agree to the solver tolerances, in the stick/slip/separation regime
+  ProblemSpec spec = spec_for_dims(12, 6, 6);
+  spec.phi = 3e6;  // 56 in contact, 28 separated, 9 sticking, 75 sliding
+  RunResult R[2];
+  for (int k = 0; k < 2; ++k) {
+    RunOptions o;
+    o.recover_interior = false;
+    o.mg.precision = k ? Precision::single_precision : Precision::double_precision;
+    R[k] = run_tresca(spec, o);
+    ASSERT_TRUE(R[k].newton.converged()) << to_string(R[k].newton.reason);
+  }
+  EXPECT_LE(std::abs(R[1].newton.iterations - R[0].newton.iterations), 1);
+  EXPECT_EQ(R[0].report.active, R[1].report.active);
+  EXPECT_EQ(R[0].report.sticking, R[1].report.sticking);
+  EXPECT_GT(R[0].report.sticking, 0);
+  EXPECT_GT(R[0].report.sliding, 0);
+  EXPECT_GT(R[0].report.separated, 0);
+  EXPECT_LT(test::max_abs_diff(R[0].newton.u, R[1].newton.u), 1e-8 * test::max_abs(R[0].newton.u));
+  EXPECT_LT(test::max_abs_diff(R[0].newton.lambda, R[1].newton.lambda), 1e-8 * test::max_abs(R[0].newton.lambda));
+  EXPECT_NEAR(R[0].report.lambda_sum, R[1].report.lambda_sum, 1e-10 * R[0].report.lambda_sum);
+  EXPECT_LT(R[1].report.true_residual_relative, 1e-10);
+}
 
 TEST(SemismoothNewton, ResultsAgreeWithOneAndTwoThreads) {
   ProblemSpec spec = spec_for_level(5);
