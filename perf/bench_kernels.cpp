@@ -1,5 +1,6 @@
 // Kernel benchmarks (Google Benchmark). Rates use the cost models stated in
-// the kernel headers: apply 48 B and 102 flop per dof (kernels/elasticity.hpp).
+// the kernel headers (kApplyCost etc.; per dof = per node / 3). The build's ISA
+// and vector width are printed in the context header.
 //   OMP_NUM_THREADS=2 build/bin/bench_kernels --benchmark_filter=Apply
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -30,24 +31,28 @@ void set_rates(benchmark::State& st, double dofs, double bytes_per_dof, double f
   st.counters["dofs"] = dofs;
 }
 
-template <bool kRef>
+// T: double, float (the single-precision V-cycle's apply); kRef: the serial _ref twin (double)
+template <class T, bool kRef>
 void BM_Apply(benchmark::State& st) {
   const Problem P = make_problem(spec_for_level(int(st.range(0))));
   const ElasticityStencil k = build_elasticity_stencil(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
-  auto x = ramp(k.size());
-  std::vector<real> y(k.size());
+  const ElasticityStencilT<T> kt = stencil_in_precision<T>(k);
+  const auto xd = ramp(k.size());
+  std::vector<T> x(xd.begin(), xd.end()), y(k.size());
   for (auto _ : st) {
-    if (kRef)
+    if constexpr (kRef)
       elasticity_apply_ref(k, x.data(), y.data(), 0, P.grid.nz());
     else
-      elasticity_apply(k, x.data(), y.data(), 0, P.grid.nz());
+      elasticity_apply<T>(kt, x.data(), y.data(), 0, P.grid.nz());
     benchmark::DoNotOptimize(y.data());
     benchmark::ClobberMemory();
   }
-  set_rates(st, double(k.size()), 16, 102);
+  const Cost c = in_precision<T>(kApplyCost);
+  set_rates(st, double(k.size()), c.bytes / 3, c.flops / 3);
 }
-BENCHMARK_TEMPLATE(BM_Apply, false)->Name("Apply")->DenseRange(6, 11)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_Apply, true)->Name("ApplyRef")->DenseRange(3, 6)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Apply, double, false)->Name("Apply")->DenseRange(6, 12, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Apply, float, false)->Name("ApplyFloat")->DenseRange(6, 12, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Apply, double, true)->Name("ApplyRef")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void BM_VCycle(benchmark::State& st) {
   const Problem P = make_problem(spec_for_level(int(st.range(0))));
@@ -77,7 +82,8 @@ void BM_Transfer(benchmark::State& st) {
     prolongate(t, 3, cc.data(), f.data());
     benchmark::DoNotOptimize(f.data());
   }
-  set_rates(st, double(3 * P.grid.nodes()), 2 * 8 * 1.25, 0);
+  const Cost cost = kRestrictCost + kProlongateCost;
+  set_rates(st, double(3 * P.grid.nodes()), cost.bytes, cost.flops);
 }
 BENCHMARK(BM_Transfer)->Name("RestrictProlong")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
@@ -85,7 +91,7 @@ void BM_Dot(benchmark::State& st) {
   const index n = index(st.range(0));
   auto x = ramp(n), y = ramp(n);
   for (auto _ : st) benchmark::DoNotOptimize(dot(n, x.data(), y.data()));
-  set_rates(st, double(n), 16, 2);
+  set_rates(st, double(n), kDotCost.bytes, kDotCost.flops);
 }
 BENCHMARK(BM_Dot)->Name("Dot")->Arg(1 << 20)->Arg(1 << 24)->UseRealTime();
 

@@ -71,9 +71,10 @@ double triad_bandwidth(tresca::index n, int reps) {
   return 24.0 * double(n) / t;
 }
 
-// peak flop/s of the build's vectors: K independent FMA chains per thread
+// peak flop/s of the build's vectors of T: K independent FMA chains per thread
+template <class T>
 double fma_peak(long iterations) {
-  using V = Vec<real>;
+  using V = Vec<T>;
   constexpr int K = 12;
   real sink = 0;
   const double t = best_of(3, [&] {
@@ -81,23 +82,24 @@ double fma_peak(long iterations) {
 #pragma omp parallel reduction(+ : total)
     {
       V acc[K];
-      for (int k = 0; k < K; ++k) acc[k] = V{} + real(k + 1) * 1e-3;
-      const V a = V{} + real(0.999999), b = V{} + real(1e-7);
+      for (int k = 0; k < K; ++k) acc[k] = V{} + T(k + 1) * T(1e-3);
+      const V a = V{} + T(0.999999), b = V{} + T(1e-7);
       for (long it = 0; it < iterations; ++it)
         for (int k = 0; k < K; ++k) acc[k] = acc[k] * a + b;
       for (int k = 0; k < K; ++k)
-        for (int l = 0; l < Simd<real>::lanes; ++l) total += acc[k][l];
+        for (int l = 0; l < Simd<T>::lanes; ++l) total += acc[k][l];
     }
     sink += total;
   });
   if (!(sink > 0)) std::fprintf(stderr, "roofline: FMA check failed\n");
-  return 2.0 * K * Simd<real>::lanes * double(iterations) * omp_get_max_threads() / t;
+  return 2.0 * K * Simd<T>::lanes * double(iterations) * omp_get_max_threads() / t;
 }
 
 struct Row {
   std::string name;
   double items, seconds;
   Cost cost;  // total for one call
+  bool single;  // float data: compared with the float FMA peak
 };
 
 }  // namespace
@@ -120,11 +122,11 @@ int main(int argc, char** argv) {
 
     const double stream = triad_bandwidth(tresca::index(1) << 25, int(std::min(reps, 10LL)));
     const double bw = stream * 32.0 / 24.0;  // with the write-allocate read of a
-    const double peak = fma_peak(20000000);
+    const double peak = fma_peak<double>(20000000), peak_single = fma_peak<float>(20000000);
     std::printf("# %s, %d threads\n", build_info().c_str(), threads);
     std::printf("# machine: triad %.2f GB/s (STREAM count), %.2f GB/s of traffic with write-allocate (the bound);\n"
-                "#          FMA peak %.2f GFLOP/s; machine balance %.1f flop/byte\n",
-                stream * 1e-9, bw * 1e-9, peak * 1e-9, peak / bw);
+                "#          FMA peak %.2f GFLOP/s double, %.2f single; machine balance %.1f flop/byte (double)\n",
+                stream * 1e-9, bw * 1e-9, peak * 1e-9, peak_single * 1e-9, peak / bw);
 
     const Problem P = make_problem(spec);
     const GridDims& g = P.grid;
@@ -150,10 +152,14 @@ int main(int argc, char** argv) {
     const int R = int(reps);
     const double nodes = double(N), dofs = double(n);
     std::vector<Row> rows;
-    auto add = [&](const char* name, double items, Cost cost, const std::function<void()>& f) {
-      rows.push_back({name, items, best_of(R, f), cost});
+    auto add = [&](const char* name, double items, Cost cost, const std::function<void()>& f, bool single = false) {
+      rows.push_back({name, items, best_of(R, f), cost, single});
     };
     add("apply y = Kx", dofs, nodes * kApplyCost, [&] { elasticity_apply(k, x.data(), y.data(), 0, g.nz()); });
+    const ElasticityStencilT<float> kf = stencil_in_precision<float>(k);
+    std::vector<float> xf(x.begin(), x.end()), yf(n);
+    add("apply (float)", dofs, nodes * in_precision<float>(kApplyCost),
+        [&] { elasticity_apply<float>(kf, xf.data(), yf.data(), 0, g.nz()); }, true);
     add("residual b - Kx", dofs, nodes * kResidualCost,
         [&] { elasticity_apply(k, x.data(), y.data(), 0, g.nz(), b.data()); });
     add("bottom block", 3.0 * M, double(M) * kBottomBlockCost,
@@ -168,7 +174,11 @@ int main(int argc, char** argv) {
     add("approximation step", nodes, nodes * kApproximationStepCost, [&] {
       approximation_step(N, 1.0, x.data(), lam.data(), b.data(), v.data(), d.data(), status.data());
     });
-    add("V-cycle (K_ii)", dofs, Cost{}, [&] { mg.apply(b.data(), y.data()); });
+    add("V-cycle (single)", dofs, Cost{}, [&] { mg.apply(b.data(), y.data()); });
+    MGOptions md;
+    md.precision = Precision::double_precision;
+    Multigrid mgd(g, P.interior_faces, P.spec.E, P.spec.nu, md);
+    add("V-cycle (double)", dofs, Cost{}, [&] { mgd.apply(b.data(), y.data()); });
 
     std::printf("# level %lld: mesh %s, %lld dofs\n", level, dims_string(spec).c_str(), (long long)n);
     std::printf("%-20s %10s %11s %8s %8s %9s %8s %9s\n", "kernel", "time [ms]", "M items/s", "GB/s", "of BW",
@@ -176,14 +186,16 @@ int main(int argc, char** argv) {
     std::string out = "{\"build\": \"" + build_info() + "\", \"threads\": " + std::to_string(threads) +
                       ", \"level\": " + std::to_string(level) + ", \"triad_stream_bytes_per_s\": " + std::to_string(stream) +
                       ", \"bandwidth_bytes_per_s\": " + std::to_string(bw) +
-                      ", \"peak_flops_per_s\": " + std::to_string(peak) + ", \"kernels\": [";
+                      ", \"peak_flops_per_s\": " + std::to_string(peak) +
+                      ", \"peak_flops_per_s_single\": " + std::to_string(peak_single) + ", \"kernels\": [";
     for (size_t i = 0; i < rows.size(); ++i) {
       const Row& r = rows[i];
       const double gbs = r.cost.bytes / r.seconds, gfs = r.cost.flops / r.seconds;
-      const double bound = std::max(r.cost.bytes / bw, r.cost.flops / peak);
+      const double pk = r.single ? peak_single : peak;
+      const double bound = std::max(r.cost.bytes / bw, r.cost.flops / pk);
       if (r.cost.bytes > 0)
         std::printf("%-20s %10.3f %11.1f %8.2f %7.0f%% %9.2f %7.0f%% %8.0f%%\n", r.name.c_str(), r.seconds * 1e3,
-                    r.items / r.seconds * 1e-6, gbs * 1e-9, 100 * gbs / bw, gfs * 1e-9, 100 * gfs / peak,
+                    r.items / r.seconds * 1e-6, gbs * 1e-9, 100 * gbs / bw, gfs * 1e-9, 100 * gfs / pk,
                     100 * bound / r.seconds);
       else
         std::printf("%-20s %10.3f %11.1f %8s %8s %9s %8s %9s\n", r.name.c_str(), r.seconds * 1e3,
@@ -191,7 +203,7 @@ int main(int argc, char** argv) {
       Json j;
       j.str("kernel", r.name).num("seconds", r.seconds).num("items_per_s", r.items / r.seconds)
           .num("bytes_per_s", gbs).num("flops_per_s", gfs).num("fraction_of_bandwidth", gbs / bw)
-          .num("fraction_of_peak", gfs / peak).num("fraction_of_bound", bound / r.seconds);
+          .num("fraction_of_peak", gfs / pk).num("fraction_of_bound", bound / r.seconds);
       out += (i ? ",\n  " : "\n  ") + j.render();
     }
     out += "]}\n";

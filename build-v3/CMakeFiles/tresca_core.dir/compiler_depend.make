@@ -2827,6 +2827,7 @@ CMakeFiles/tresca_core.dir/core/multigrid.cpp.o: /work/main/core/multigrid.cpp \
   /usr/include/eigen3/Eigen/src/Eigenvalues/GeneralizedEigenSolver.h \
   /usr/include/eigen3/Eigen/src/Eigenvalues/RealQZ.h \
   /usr/include/eigen3/Eigen/src/Eigenvalues/MatrixBaseEigenvalues.h \
+  /work/main/kernels/boundary_block.hpp \
   /work/main/kernels/vector_ops.hpp \
   /work/main/core/profile.hpp
 

@@ -488,4 +488,5 @@ CMakeFiles/bench_kernels.dir/perf/bench_kernels.cpp.o: \
  /work/main/core/assembly.hpp /usr/include/eigen3/Eigen/SparseCore \
  /work/main/core/elasticity_operator.hpp \
  /work/main/core/../kernels/elasticity.hpp /work/main/core/operator.hpp \
- /work/main/core/problem.hpp /work/main/kernels/vector_ops.hpp
+ /work/main/core/problem.hpp /work/main/kernels/simd.hpp \
+ /work/main/kernels/vector_ops.hpp

@@ -494,4 +494,4 @@ CMakeFiles/mg_scaling.dir/perf/mg_scaling.cpp.o: \
  /usr/include/eigen3/Eigen/SparseCore \
  /work/main/core/elasticity_operator.hpp \
  /work/main/core/../kernels/elasticity.hpp /work/main/core/output.hpp \
- /work/main/core/profile.hpp
+ /work/main/core/profile.hpp /work/main/kernels/simd.hpp

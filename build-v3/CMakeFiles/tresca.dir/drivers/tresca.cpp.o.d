@@ -495,4 +495,4 @@ CMakeFiles/tresca.dir/drivers/tresca.cpp.o: /work/main/drivers/tresca.cpp \
  /work/main/core/../kernels/transfer.hpp /work/main/core/assembly.hpp \
  /usr/include/eigen3/Eigen/SparseCore \
  /work/main/core/elasticity_operator.hpp \
- /work/main/core/../kernels/elasticity.hpp
+ /work/main/core/../kernels/elasticity.hpp /work/main/kernels/simd.hpp

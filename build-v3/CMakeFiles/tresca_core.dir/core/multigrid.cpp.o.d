@@ -546,4 +546,5 @@ CMakeFiles/tresca_core.dir/core/multigrid.cpp.o: \
  /usr/include/eigen3/Eigen/src/Eigenvalues/GeneralizedEigenSolver.h \
  /usr/include/eigen3/Eigen/src/Eigenvalues/RealQZ.h \
  /usr/include/eigen3/Eigen/src/Eigenvalues/MatrixBaseEigenvalues.h \
+ /work/main/core/../kernels/boundary_block.hpp \
  /work/main/core/../kernels/vector_ops.hpp /work/main/core/profile.hpp
