@@ -49,30 +49,37 @@ Transfer build_transfer(const GridDims& fine, const GridDims& coarse) {
 
 template <class T>
 void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool accumulate) {
+  // Per fine row (iy, iz): combine the 4 coarse rows of its y/z support into
+  // one coarse-length row buffer (contiguous, vectorised), then interpolate
+  // along x from that buffer (it sits in L1): 4 FMAs per coarse node plus
+  // 2 per fine node, instead of 8 coarse reads per fine node.
   const GridDims &f = t.fine, &c = t.coarse;
-  const index Nf = f.nodes(), Nc = c.nodes();
+  const index Nf = f.nodes(), Nc = c.nodes(), cnx = c.nx(), cny = c.ny(), fnx = f.nx();
   const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
-#pragma omp parallel for collapse(2) schedule(static)
-  for (index iz = 0; iz < f.nz(); ++iz)
-    for (index iy = 0; iy < f.ny(); ++iy) {
-      const index jz = Z.j0[iz], jy = Y.j0[iy];
-      const T wz = T(Z.w[iz]), wy = T(Y.w[iy]);
-      const T w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
-      const index cnx = c.nx(), cny = c.ny();
-      const index b00 = cnx * (jy + cny * jz), b10 = b00 + cnx, b01 = b00 + cnx * cny, b11 = b01 + cnx;
-      for (int a = 0; a < comps; ++a) {
-        const T* u = coarse + a * Nc;
-        T* v = fine + a * Nf + f.nx() * (iy + f.ny() * iz);
-        for (index ix = 0; ix < f.nx(); ++ix) {
-          const index j = X.j0[ix];
-          const T wx = T(X.w[ix]);
-          const T s0 = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
-          const T s1 =
-              w00 * u[b00 + j + 1] + w10 * u[b10 + j + 1] + w01 * u[b01 + j + 1] + w11 * u[b11 + j + 1];
-          v[ix] = (accumulate ? v[ix] : 0) + (1 - wx) * s0 + wx * s1;
+#pragma omp parallel
+  {
+    std::vector<T> row(cnx);  // one buffer per thread, allocated once per call
+    T* s = row.data();
+#pragma omp for collapse(2) schedule(static)
+    for (index iz = 0; iz < f.nz(); ++iz)
+      for (index iy = 0; iy < f.ny(); ++iy) {
+        const index jz = Z.j0[iz], jy = Y.j0[iy];
+        const T wz = T(Z.w[iz]), wy = T(Y.w[iy]);
+        const T w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
+        const index b00 = cnx * (jy + cny * jz), b10 = b00 + cnx, b01 = b00 + cnx * cny, b11 = b01 + cnx;
+        for (int a = 0; a < comps; ++a) {
+          const T* u = coarse + a * Nc;
+#pragma omp simd
+          for (index j = 0; j < cnx; ++j) s[j] = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
+          T* v = fine + a * Nf + fnx * (iy + f.ny() * iz);
+          for (index ix = 0; ix < fnx; ++ix) {
+            const index j = X.j0[ix];
+            const T wx = T(X.w[ix]);
+            v[ix] = (accumulate ? v[ix] : T(0)) + (1 - wx) * s[j] + wx * s[j + 1];
+          }
         }
       }
-    }
+  }
 }
 
 template void prolongate<double>(const Transfer&, int, const double*, double*, bool);

@@ -6,8 +6,9 @@
 //
 // P is a tensor product P = Pz ⊗ Py ⊗ Px of 1D interpolations, each row with
 // at most two nonzeros. The optimised kernels are gathers (race-free, OpenMP
-// over output rows): prolongation reads 8 coarse values per fine node;
-// restriction sums, per coarse row, the weighted fine rows of its y/z support
+// over output rows): prolongation combines, per fine row, the 4 coarse rows
+// of its y/z support into a coarse-length row buffer (vectorised) and then
+// interpolates along x from it; restriction sums, per coarse row, the weighted fine rows of its y/z support
 // into a row buffer (vectorised) and then gathers along x with the 1D
 // transposed lists. The _ref twins are the literal serial loops (restriction
 // as a scatter of P^T).
