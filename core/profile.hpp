@@ -27,6 +27,19 @@ void profile_reset();
 std::string profile_table(double total_seconds);
 
 double wall_time();
+// the shortest of `reps` wall-clock timings of f() (the minimum filters out
+// interruptions by other processes)
+template <class F>
+double best_time(int reps, F&& f) {
+  double best = 1e300;
+  for (int r = 0; r < reps; ++r) {
+    const double t0 = wall_time();
+    f();
+    const double t = wall_time() - t0;
+    best = t < best ? t : best;
+  }
+  return best;
+}
 // peak resident memory of this process so far, in bytes (getrusage)
 double peak_memory_bytes();
 

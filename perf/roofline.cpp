@@ -40,13 +40,7 @@ namespace {
 
 double best_of(int reps, const std::function<void()>& f) {
   f();  // warm-up: page faults, caches
-  double best = 1e300;
-  for (int r = 0; r < reps; ++r) {
-    const double t0 = wall_time();
-    f();
-    best = std::min(best, wall_time() - t0);
-  }
-  return best;
+  return best_time(reps, f);
 }
 
 // STREAM triad, bytes per second as STREAM counts them (24 per entry)

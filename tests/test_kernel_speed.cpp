@@ -23,20 +23,6 @@
 
 namespace tresca {
 
-namespace {
-// best of `reps` timings of f (min filters out interruptions by other processes)
-template <class F>
-double best_time(int reps, F f) {
-  double best = 1e300;
-  for (int r = 0; r < reps; ++r) {
-    const double t0 = wall_time();
-    f();
-    best = std::min(best, wall_time() - t0);
-  }
-  return best;
-}
-}  // namespace
-
 TEST(KernelSpeed, OptimisedApplyIsFarFasterThanItsReferenceTwin) {
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);

@@ -1,3 +1,0 @@
-file(REMOVE_RECURSE
-  "libtresca_kernels.a"
-)
