@@ -7,9 +7,9 @@
 
 #include <cmath>
 
-#include "core/cli.hpp"
-#include "core/interior.hpp"
-#include "core/profile.hpp"
+#include "core/io/cli.hpp"
+#include "core/fem/interior.hpp"
+#include "core/util/profile.hpp"
 
 using namespace tresca;
 

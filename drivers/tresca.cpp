@@ -7,10 +7,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/cli.hpp"
-#include "core/output.hpp"
-#include "core/profile.hpp"
-#include "core/run.hpp"
+#include "core/io/cli.hpp"
+#include "core/io/output.hpp"
+#include "core/util/profile.hpp"
+#include "core/contact/run.hpp"
 #include "kernels/simd.hpp"
 
 using namespace tresca;

@@ -7,8 +7,8 @@
 
 #include <vector>
 
-#include "core/multigrid.hpp"
-#include "core/problem.hpp"
+#include "core/solvers/multigrid.hpp"
+#include "core/fem/problem.hpp"
 #include "kernels/simd.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"

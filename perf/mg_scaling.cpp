@@ -4,10 +4,10 @@
 #include <cstdio>
 #include <exception>
 
-#include "core/cli.hpp"
-#include "core/interior.hpp"
-#include "core/output.hpp"
-#include "core/profile.hpp"
+#include "core/io/cli.hpp"
+#include "core/fem/interior.hpp"
+#include "core/io/output.hpp"
+#include "core/util/profile.hpp"
 #include "kernels/simd.hpp"
 
 using namespace tresca;

@@ -22,11 +22,11 @@
 #include <string>
 #include <vector>
 
-#include "core/cli.hpp"
-#include "core/multigrid.hpp"
-#include "core/output.hpp"
-#include "core/problem.hpp"
-#include "core/profile.hpp"
+#include "core/io/cli.hpp"
+#include "core/solvers/multigrid.hpp"
+#include "core/io/output.hpp"
+#include "core/fem/problem.hpp"
+#include "core/util/profile.hpp"
 #include "kernels/boundary_block.hpp"
 #include "kernels/contact_maps.hpp"
 #include "kernels/elasticity.hpp"

@@ -5,8 +5,8 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "core/assembly.hpp"
-#include "core/problem.hpp"
+#include "core/fem/assembly.hpp"
+#include "core/fem/problem.hpp"
 
 namespace tresca {
 struct DenseSchur {

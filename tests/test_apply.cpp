@@ -4,8 +4,8 @@
 
 #include <Eigen/SparseCore>
 
-#include "core/assembly.hpp"
-#include "core/elasticity_operator.hpp"
+#include "core/fem/assembly.hpp"
+#include "core/fem/elasticity_operator.hpp"
 #include "kernels/boundary_block.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"

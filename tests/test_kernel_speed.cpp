@@ -15,8 +15,8 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "core/problem.hpp"
-#include "core/profile.hpp"
+#include "core/fem/problem.hpp"
+#include "core/util/profile.hpp"
 #include "kernels/elasticity.hpp"
 #include "kernels/simd.hpp"
 #include "test_helpers.hpp"

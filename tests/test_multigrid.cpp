@@ -4,10 +4,10 @@
 
 #include <Eigen/SparseCholesky>
 
-#include "core/cg.hpp"
-#include "core/interior.hpp"
-#include "core/multigrid.hpp"
-#include "core/problem.hpp"
+#include "core/solvers/cg.hpp"
+#include "core/fem/interior.hpp"
+#include "core/solvers/multigrid.hpp"
+#include "core/fem/problem.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"
 

@@ -8,8 +8,8 @@
 
 #include <Eigen/Dense>
 
-#include "core/report.hpp"
-#include "core/run.hpp"
+#include "core/contact/report.hpp"
+#include "core/contact/run.hpp"
 #include "dense_reference.hpp"
 #include "test_helpers.hpp"
 

@@ -5,8 +5,8 @@
 
 #include <Eigen/Dense>
 
-#include "core/assembly.hpp"
-#include "core/steklov.hpp"
+#include "core/fem/assembly.hpp"
+#include "core/contact/steklov.hpp"
 #include "dense_reference.hpp"
 #include "test_helpers.hpp"
 

@@ -7,8 +7,8 @@
 #include <memory>
 #include <vector>
 
-#include "report.hpp"
-#include "semismooth.hpp"
+#include "core/contact/report.hpp"
+#include "core/contact/semismooth.hpp"
 
 namespace tresca {
 

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "operator.hpp"
+#include "core/solvers/operator.hpp"
 
 namespace tresca {
 

@@ -1,10 +1,10 @@
-#include "report.hpp"
+#include "core/contact/report.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "../kernels/contact_maps.hpp"
-#include "../kernels/vector_ops.hpp"
+#include "kernels/contact_maps.hpp"
+#include "kernels/vector_ops.hpp"
 
 namespace tresca {
 

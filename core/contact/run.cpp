@@ -1,6 +1,6 @@
-#include "run.hpp"
+#include "core/contact/run.hpp"
 
-#include "profile.hpp"
+#include "core/util/profile.hpp"
 
 namespace tresca {
 

@@ -1,4 +1,4 @@
-#include "cli.hpp"
+#include "core/io/cli.hpp"
 
 #include <omp.h>
 #include <unistd.h>

@@ -17,9 +17,9 @@
 #pragma once
 #include <vector>
 
-#include "cg.hpp"
-#include "multigrid.hpp"
-#include "problem.hpp"
+#include "core/solvers/cg.hpp"
+#include "core/solvers/multigrid.hpp"
+#include "core/fem/problem.hpp"
 
 namespace tresca {
 

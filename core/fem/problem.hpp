@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "../kernels/grid.hpp"
-#include "../kernels/types.hpp"
+#include "kernels/grid.hpp"
+#include "kernels/types.hpp"
 
 namespace tresca {
 

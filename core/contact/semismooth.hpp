@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "steklov.hpp"
+#include "core/contact/steklov.hpp"
 
 namespace tresca {
 

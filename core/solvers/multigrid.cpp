@@ -1,4 +1,4 @@
-#include "multigrid.hpp"
+#include "core/solvers/multigrid.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -6,9 +6,9 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "../kernels/boundary_block.hpp"
-#include "../kernels/vector_ops.hpp"
-#include "profile.hpp"
+#include "kernels/boundary_block.hpp"
+#include "kernels/vector_ops.hpp"
+#include "core/util/profile.hpp"
 
 namespace tresca {
 

@@ -6,8 +6,8 @@
 #pragma once
 #include <vector>
 
-#include "../kernels/elasticity.hpp"
-#include "operator.hpp"
+#include "kernels/elasticity.hpp"
+#include "core/solvers/operator.hpp"
 
 namespace tresca {
 

@@ -1,7 +1,7 @@
-#include "elasticity_operator.hpp"
+#include "core/fem/elasticity_operator.hpp"
 
-#include "../kernels/boundary_block.hpp"
-#include "profile.hpp"
+#include "kernels/boundary_block.hpp"
+#include "core/util/profile.hpp"
 
 namespace tresca {
 

@@ -1,13 +1,13 @@
-#include "semismooth.hpp"
+#include "core/contact/semismooth.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
 
-#include "../kernels/contact_maps.hpp"
-#include "../kernels/vector_ops.hpp"
-#include "boundary_preconditioner.hpp"
-#include "profile.hpp"
+#include "kernels/contact_maps.hpp"
+#include "kernels/vector_ops.hpp"
+#include "core/contact/boundary_preconditioner.hpp"
+#include "core/util/profile.hpp"
 
 namespace tresca {
 

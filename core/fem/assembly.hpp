@@ -5,7 +5,7 @@
 #pragma once
 #include <Eigen/SparseCore>
 
-#include "elasticity_operator.hpp"
+#include "core/fem/elasticity_operator.hpp"
 
 namespace tresca {
 

@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "semismooth.hpp"
+#include "core/contact/semismooth.hpp"
 
 namespace tresca {
 

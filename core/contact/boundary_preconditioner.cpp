@@ -1,4 +1,4 @@
-#include "boundary_preconditioner.hpp"
+#include "core/contact/boundary_preconditioner.hpp"
 
 namespace tresca {
 

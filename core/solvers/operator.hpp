@@ -1,7 +1,7 @@
 // What a solver sees: a square linear operator y = A x on vectors of size().
 // (MFEM Operator::Mult, Ginkgo LinOp.) Preconditioners are operators too.
 #pragma once
-#include "../kernels/types.hpp"
+#include "kernels/types.hpp"
 
 namespace tresca {
 

@@ -1,9 +1,9 @@
-#include "cg.hpp"
+#include "core/solvers/cg.hpp"
 
 #include <cmath>
 
-#include "../kernels/vector_ops.hpp"
-#include "profile.hpp"
+#include "kernels/vector_ops.hpp"
+#include "core/util/profile.hpp"
 
 namespace tresca {
 

@@ -37,9 +37,9 @@
 #include <string>
 #include <vector>
 
-#include "../kernels/transfer.hpp"
-#include "assembly.hpp"
-#include "elasticity_operator.hpp"
+#include "kernels/transfer.hpp"
+#include "core/fem/assembly.hpp"
+#include "core/fem/elasticity_operator.hpp"
 
 namespace tresca {
 

@@ -4,7 +4,7 @@
 #pragma once
 #include <string>
 
-#include "../kernels/types.hpp"
+#include "kernels/types.hpp"
 
 namespace tresca {
 

@@ -1,11 +1,11 @@
-#include "output.hpp"
+#include "core/io/output.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
 
-#include "../kernels/contact_maps.hpp"
+#include "kernels/contact_maps.hpp"
 
 namespace tresca {
 

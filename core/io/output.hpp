@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "problem.hpp"
+#include "core/fem/problem.hpp"
 
 namespace tresca {
 

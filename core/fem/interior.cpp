@@ -1,7 +1,7 @@
-#include "interior.hpp"
+#include "core/fem/interior.hpp"
 
-#include "../kernels/vector_ops.hpp"
-#include "profile.hpp"
+#include "kernels/vector_ops.hpp"
+#include "core/util/profile.hpp"
 
 namespace tresca {
 

@@ -1,4 +1,4 @@
-#include "profile.hpp"
+#include "core/util/profile.hpp"
 
 #include <omp.h>
 #include <sys/resource.h>

@@ -1,10 +1,10 @@
-#include "steklov.hpp"
+#include "core/contact/steklov.hpp"
 
 #include <stdexcept>
 #include <string>
 
-#include "../kernels/vector_ops.hpp"
-#include "profile.hpp"
+#include "kernels/vector_ops.hpp"
+#include "core/util/profile.hpp"
 
 namespace tresca {
 

@@ -1,4 +1,4 @@
-#include "problem.hpp"
+#include "core/fem/problem.hpp"
 
 #include <cmath>
 #include <sstream>

@@ -16,8 +16,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "multigrid.hpp"
-#include "steklov.hpp"
+#include "core/solvers/multigrid.hpp"
+#include "core/contact/steklov.hpp"
 
 namespace tresca {
 

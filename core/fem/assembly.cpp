@@ -1,4 +1,4 @@
-#include "assembly.hpp"
+#include "core/fem/assembly.hpp"
 
 #include <vector>
 
