@@ -30,6 +30,9 @@ class BoundaryPreconditioner : public LinearOperator {
   // Rebuild B for the current Newton system: h (3 blocks of p: h11, h12, h22
   // on sliding nodes), `fixed` (3p bytes, 1 where the increment is known)
   // and `free` mask (3p bytes) of the reduced system.
+  // work of one apply in fine-grid matvec equivalents (one V-cycle of K + B)
+  double apply_work() const { return mg_.cycle_work(); }
+
   void update(const std::vector<real>& h, const std::vector<std::uint8_t>& fixed,
               const std::vector<std::uint8_t>& free_mask);
 

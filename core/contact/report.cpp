@@ -12,11 +12,8 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
                          const NewtonResult& R, real tight_rtol) {
   const index p = S.size() / 3;
   FinalReport F;
-  const real keep = S.inner_rtol();
-  S.set_inner_rtol(tight_rtol);
   std::vector<real> Su(3 * p), v(4 * p), d(3 * p);
-  S.apply(R.u.data(), Su.data());
-  S.set_inner_rtol(keep);
+  F.inner = S.apply(R.u.data(), Su.data(), tight_rtol);
   F.r.resize(3 * p);
   for (index i = 0; i < 3 * p; ++i) F.r[i] = Su[i] - btilde[i];
   F.status.resize(p);

@@ -26,6 +26,7 @@ struct FinalReport {
   real ux_min = 0, uz_max = 0, lambda_sum = 0;
   std::vector<real> r;                // S u − b̃ (contact forces: r_τ friction, r_z = λ)
   std::vector<std::uint8_t> status;   // kContact | kStick
+  SolveStats inner;                   // the tight inner solve behind S u
 };
 
 FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, real phi,

@@ -11,11 +11,11 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   SteklovPoincare S(*R.problem, opt.mg);
   const double t1 = wall_time();
   if (opt.phase_done) opt.phase_done("setup (mesh, operators, multigrid)", t1 - t0);
-  const std::vector<real> btilde = S.condensed_load(opt.tight_rtol);
+  std::vector<real> btilde;
+  const SolveStats cond = S.condensed_load(opt.tight_rtol, btilde);
   const double t2 = wall_time();
   if (opt.phase_done) opt.phase_done("condensed load", t2 - t1);
-  const double apply_nodes0 = profile_get(Kernel::apply).items;
-  if (S.stats().failures > 0) {
+  if (!cond.ok()) {
     // b̃ is untrustworthy: report instead of iterating on a wrong problem
     const index p = R.problem->contact_nodes();
     R.newton.reason = NewtonReason::inner_failure;
@@ -26,14 +26,15 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.newton = semismooth_newton(S, btilde, spec.phi, opt.newton);
   }
   const double t3 = wall_time();
-  R.fine_matvecs_solve = (profile_get(Kernel::apply).items - apply_nodes0) / double(R.problem->nodes());
+  R.fine_matvecs_solve = R.newton.fine_matvecs;
   if (opt.phase_done) opt.phase_done("semismooth* Newton", t3 - t2);
   R.report = final_report(S, btilde, spec.phi, R.newton, opt.tight_rtol);
-  if (opt.recover_interior) R.u_full = S.recover(R.newton.u.data(), opt.tight_rtol);
+  SolveStats rec;
+  if (opt.recover_interior) rec = S.recover(R.newton.u.data(), opt.tight_rtol, R.u_full);
   const double t4 = wall_time();
   if (opt.phase_done) opt.phase_done("final check and recovery", t4 - t3);
   R.times = {t1 - t0, t2 - t1, t3 - t2, t4 - t3, t4 - t0};
-  R.inner_iterations = S.stats().iterations;
+  R.inner_iterations = cond.iterations + R.newton.inner_iterations + R.report.inner.iterations + rec.iterations;
   R.peak_memory = peak_memory_bytes();
   return R;
 }

@@ -24,29 +24,18 @@ const char* to_string(NewtonReason r) {
 
 namespace {
 
-// y = mask_F (S x + H x); remembers S x for the incremental update of S u.
-class ReducedNewtonOperator : public LinearOperator {
- public:
-  ReducedNewtonOperator(const SteklovPoincare& S, const std::vector<real>& h, const std::vector<std::uint8_t>& free)
-      : Sx(S.size()), S_(S), h_(h), free_(free) {}
-  index size() const override { return S_.size(); }
-  void apply(const real* x, real* y) const override {
-    S_.apply(x, Sx.data());
-    const index p = S_.size() / 3;
-    for (index i = 0; i < p; ++i) {
-      y[i] = Sx[i] + h_[i] * x[i] + h_[p + i] * x[p + i];
-      y[p + i] = Sx[p + i] + h_[p + i] * x[i] + h_[2 * p + i] * x[p + i];
-      y[2 * p + i] = Sx[2 * p + i];
-    }
-    for (index i = 0; i < 3 * p; ++i)
-      if (!free_[i]) y[i] = 0;
+// Inner (K_ii) work of the S applications of one Newton solve.
+struct InnerWork {
+  long long iterations = 0, failures = 0;
+  double fine_matvecs = 0;  // SteklovPoincare::apply_work of each application
+  // one application of S at inner tolerance rtol, counted; false if the inner solve failed
+  bool apply(const SteklovPoincare& S, const real* v, real* Sv, real rtol) {
+    const SolveStats st = S.apply(v, Sv, rtol);
+    iterations += st.iterations;
+    failures += st.ok() ? 0 : 1;
+    fine_matvecs += S.apply_work(st.iterations);
+    return st.ok();
   }
-  mutable std::vector<real> Sx;
-
- private:
-  const SteklovPoincare& S_;
-  const std::vector<real>& h_;
-  const std::vector<std::uint8_t>& free_;
 };
 
 // The reduced Newton system of one step (method.md §4).
@@ -86,39 +75,121 @@ bool linearise(index p, real phi, const std::vector<std::uint8_t>& status, const
   return any_known;
 }
 
+// y = mask_F (S x + H x), with S x as the side product (the Newton update
+// reuses it: S u += S Δu without another application of S). The inner
+// tolerance is this step's own state, relaxed as its outer CG converges.
+class ReducedNewtonOperator : public LinearOperatorWithSide {
+ public:
+  ReducedNewtonOperator(const SteklovPoincare& S, const ReducedSystem& L, InnerWork& work)
+      : S_(S), L_(L), work_(work) {}
+  index size() const override { return S_.size(); }
+  index side_size() const override { return S_.size(); }
+  void set_inner_rtol(real r) { rtol_ = r; }
+  void apply(const real* x, real* y, real* Sx) const override {
+    work_.apply(S_, x, Sx, rtol_);
+    const index p = S_.size() / 3;
+    const real* h = L_.h.data();
+    for (index i = 0; i < p; ++i) {
+      y[i] = Sx[i] + h[i] * x[i] + h[p + i] * x[p + i];
+      y[p + i] = Sx[p + i] + h[p + i] * x[i] + h[2 * p + i] * x[p + i];
+      y[2 * p + i] = Sx[2 * p + i];
+    }
+    for (index i = 0; i < 3 * p; ++i)
+      if (!L_.free[i]) y[i] = 0;
+  }
+  void apply(const real* x, real* y) const override {
+    std::vector<real> Sx(S_.size());  // the Newton step always asks for S x too
+    apply(x, y, Sx.data());
+  }
+
+ private:
+  const SteklovPoincare& S_;
+  const ReducedSystem& L_;
+  InnerWork& work_;
+  real rtol_ = 1e-12;
+};
+
+// The result of solving one reduced Newton system.
+struct StepOutcome {
+  SolveStats outer;
+  bool inner_failed = false;
+};
+
+// Solves the reduced system of L for Δu (into du) and S Δu (into Sdu), to
+// the absolute accuracy `target` (semismooth.hpp: Tolerances).
+StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreconditioner* M, real target,
+                       bool any_known, InnerWork& work, CGWorkspace& ws, std::vector<real>& du,
+                       std::vector<real>& Sdu, std::vector<real>& scratch) {
+  const index n3 = S.size();
+  StepOutcome out;
+  const long long fails0 = work.failures;
+  // known increments enter the right-hand side: r_F -= (S Δu_known)_F
+  if (any_known) {
+    if (!work.apply(S, L.known.data(), scratch.data(), 1e-12)) {
+      out.inner_failed = true;
+      return out;
+    }
+    for (index i = 0; i < n3; ++i)
+      if (L.free[i]) L.rhs[i] -= scratch[i];
+  } else {
+    std::fill(scratch.begin(), scratch.end(), 0.0);
+  }
+  if (M) M->update(L.h, L.fixed, L.free);
+  ReducedNewtonOperator A(S, L, work);
+  CGOptions co;
+  co.rtol = 1e-13;  // attainable floor relative to |rhs|
+  co.atol = target;
+  co.max_iterations = M ? 200 : 5000;
+  // relaxed inner accuracy (Simoncini–Szyld): the perturbation of S may grow
+  // like target/|r_j| as the outer residual r_j falls
+  co.on_residual = [&](real rn) { A.set_inner_rtol(std::clamp(0.1 * target / rn, 1e-12, 1e-2)); };
+  co.abort_if = [&] { return work.failures > fails0; };  // an S apply is untrustworthy
+  {
+    ScopedTimer t(Kernel::outer_cg);
+    out.outer = pcg(A, M, L.rhs.data(), du.data(), Sdu.data(), co, ws);
+  }
+  if (M) work.fine_matvecs += out.outer.preconditioner_applications * M->apply_work();
+  out.inner_failed = work.failures > fails0;
+  // S Δu = S Δu_F (accumulated by CG) + S Δu_known
+  axpy(n3, 1, scratch.data(), Sdu.data());
+  return out;
+}
+
 }  // namespace
 
 NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, real phi,
                                const NewtonOptions& opt) {
   const double t0 = wall_time();
   const index p = S.size() / 3, n3 = 3 * p;
-  const InnerStats inner0 = S.stats();
+  InnerWork work;
   NewtonResult R;
   R.u.assign(n3, 0);
   R.lambda.assign(p, 0);
   R.Su.assign(n3, 0);
   R.status.assign(p, 0);
+  auto finish = [&](NewtonReason reason) {
+    R.reason = reason;
+    R.inner_iterations = work.iterations;
+    R.fine_matvecs = work.fine_matvecs;
+    return R;
+  };
   if (opt.u0 && opt.lambda0) {
     R.u = *opt.u0;
     R.lambda = *opt.lambda0;
-    const real keep = S.inner_rtol();
-    S.set_inner_rtol(1e-12);
-    S.apply(R.u.data(), R.Su.data());
-    S.set_inner_rtol(keep);
+    R.operator_applications += 1;
+    if (!work.apply(S, R.u.data(), R.Su.data(), 1e-12)) return finish(NewtonReason::inner_failure);
   }
-  std::vector<real> r(n3), v(4 * p), d(3 * p), du(n3), Sdu(n3);
+  std::vector<real> r(n3), v(4 * p), d(3 * p), du(n3), Sdu(n3), scratch(n3);
   ReducedSystem L(n3);
-  std::vector<real>& rhs = L.rhs;
   std::unique_ptr<BoundaryPreconditioner> M;
   if (opt.outer_pc == OuterPreconditioner::multigrid)
     M = std::make_unique<BoundaryPreconditioner>(S, S.interior_multigrid().options());
-  ReducedNewtonOperator A(S, L.h, L.free);
   CGWorkspace ws;
   real best = INFINITY;
   int since_best = 0;
 
   for (int k = 0;; ++k) {
-    // residual map and approximation step
+    // 1. approximation step at x = (u, lambda), r = S u - b̃
     real vnorm;
     {
       ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
@@ -128,77 +199,40 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     }
     R.history.push_back(vnorm);
     if (opt.progress) {
-      NewtonProgress pr{k, vnorm, 0, 0, 0, 0, S.stats().iterations - inner0.iterations, R.outer_iterations,
-                        wall_time() - t0};
+      NewtonProgress pr{k, vnorm, 0, 0, 0, 0, work.iterations, R.outer_iterations, wall_time() - t0};
       for (index i = 0; i < p; ++i) {
         (R.status[i] & kContact ? pr.active : pr.separated) += 1;
         (R.status[i] & kStick ? pr.sticking : pr.sliding) += 1;
       }
       opt.progress(pr);
     }
-    if (!std::isfinite(vnorm)) {
-      R.reason = NewtonReason::non_finite;
-      break;
-    }
-    if (vnorm <= opt.eps) {
-      R.reason = NewtonReason::converged;
-      break;
-    }
-    if (k >= opt.max_iterations) {
-      R.reason = NewtonReason::iteration_limit;
-      break;
-    }
+    if (!std::isfinite(vnorm)) return finish(NewtonReason::non_finite);
+    if (vnorm <= opt.eps) return finish(NewtonReason::converged);
+    if (k >= opt.max_iterations) return finish(NewtonReason::iteration_limit);
     if (vnorm < best) {
       best = vnorm;
       since_best = 0;
     } else if (++since_best >= opt.stagnation_window) {
-      R.reason = NewtonReason::stagnation;
-      break;
+      return finish(NewtonReason::stagnation);
     }
 
-    // Newton step: known increments, free set, H, right-hand side
+    // 2. linearisation: known increments, free set, H, right-hand side
     const bool any_known = linearise(p, phi, R.status, v, d, L);
     // Accuracy of the step, absolute: decisions compare forces with phi and
     // u_z, so early steps must be near-exact (1e-10 |v0|); late steps need
     // only a fraction of |v_k|; nothing below 0.1 eps is useful.
     const real target = std::max(0.1 * opt.eps, std::min(opt.step_accuracy * vnorm, 1e-10 * R.history[0]));
-    const long long fails0 = S.stats().failures;
-    if (any_known) {
-      S.set_inner_rtol(1e-12);
-      S.apply(L.known.data(), Sdu.data());
-      R.operator_applications += 1;
-      for (index i = 0; i < n3; ++i)
-        if (L.free[i]) rhs[i] -= Sdu[i];
-    } else {
-      std::fill(Sdu.begin(), Sdu.end(), 0.0);
-    }
-    if (M) M->update(L.h, L.fixed, L.free);
-    CGOptions co;
-    co.rtol = 1e-13;  // attainable floor relative to |rhs|
-    co.atol = target;
-    co.max_iterations = M ? 200 : 5000;
-    co.on_step = [&](real alpha) { axpy(n3, alpha, A.Sx.data(), Sdu.data()); };
-    // relaxed inner accuracy (Simoncini–Szyld): the perturbation of S may grow
-    // like target/|r_j| as the outer residual r_j falls
-    co.on_residual = [&](real rn) { S.set_inner_rtol(std::clamp(0.1 * target / rn, 1e-12, 1e-2)); };
-    co.abort_if = [&] { return S.stats().failures > fails0; };  // an S apply is untrustworthy
-    SolveStats st;
-    {
-      ScopedTimer t(Kernel::outer_cg);
-      st = pcg(A, M.get(), rhs.data(), du.data(), co, ws);
-    }
-    R.outer_iterations += st.iterations;
-    R.operator_applications += st.iterations;
-    if (st.reason == SolveReason::max_iterations) R.outer_limit_hits += 1;  // inexact step taken
-    if (S.stats().failures > fails0) {
-      R.reason = NewtonReason::inner_failure;
-      break;
-    }
-    if (st.reason == SolveReason::non_finite || st.reason == SolveReason::breakdown) {
-      R.reason = st.reason == SolveReason::non_finite ? NewtonReason::non_finite : NewtonReason::inner_failure;
-      break;
-    }
-    // update x and S u
+
+    // 3. the reduced Newton system, by preconditioned CG on the boundary
+    const StepOutcome step = solve_step(S, L, M.get(), target, any_known, work, ws, du, Sdu, scratch);
+    R.outer_iterations += step.outer.iterations;
+    R.operator_applications += step.outer.iterations + (any_known ? 1 : 0);
+    if (step.inner_failed) return finish(NewtonReason::inner_failure);
+    if (step.outer.reason == SolveReason::non_finite) return finish(NewtonReason::non_finite);
+    if (step.outer.reason == SolveReason::breakdown) return finish(NewtonReason::inner_failure);
+    if (step.outer.reason == SolveReason::max_iterations) R.outer_limit_hits += 1;  // inexact step taken
+
+    // 4. update x = (u, lambda) and S u
     for (index i = 0; i < n3; ++i) du[i] += L.known[i];
     for (index i = 0; i < p; ++i)
       R.lambda[i] += (R.status[i] & kContact) ? Sdu[2 * p + i] - v[2 * p + i] : v[3 * p + i];
@@ -206,8 +240,6 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     axpy(n3, 1, Sdu.data(), R.Su.data());
     R.iterations = k + 1;
   }
-  R.inner_iterations = S.stats().iterations - inner0.iterations;
-  return R;
 }
 
 }  // namespace tresca

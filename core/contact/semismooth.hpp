@@ -67,6 +67,9 @@ struct NewtonResult {
   std::vector<std::uint8_t> status;    // per node: kContact | kStick at the last approximation step
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
   int outer_limit_hits = 0;  // Newton steps whose outer CG stopped at its iteration limit
+  // work in fine-grid matvec equivalents, from the solvers' own counts and
+  // cost models (SteklovPoincare::apply_work, BoundaryPreconditioner::apply_work)
+  double fine_matvecs = 0;
   bool converged() const { return reason == NewtonReason::converged; }
 };
 

@@ -35,19 +35,12 @@ void SteklovPoincare::gather(const real* full, real* vc) const {
   }
 }
 
-SolveStats SteklovPoincare::solve_interior(const real* rhs, real* z) const {
+SolveStats SteklovPoincare::solve_interior(const real* rhs, real* z, real rtol) const {
   ScopedTimer t(Kernel::inner_cg);
   CGOptions o;
-  o.rtol = inner_rtol_;
+  o.rtol = rtol;
   o.max_iterations = 500;
-  SolveStats st = pcg(mg_.op(0), &mg_, rhs, z, o, ws_);
-  stats_.solves += 1;
-  stats_.iterations += st.iterations;
-  if (!st.ok()) {
-    stats_.failures += 1;
-    stats_.last_failure = st.reason;
-  }
-  return st;
+  return pcg(mg_.op(0), &mg_, rhs, z, o, ws_);
 }
 
 void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
@@ -62,7 +55,7 @@ void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
   }
 }
 
-void SteklovPoincare::apply(const real* v, real* Sv) const {
+SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol) const {
   // Invariants between calls: w_ is zero off the contact nodes, t_ is zero
   // off plane 1, so only plane-sized work surrounds the inner solve.
   const GridDims& g = P_.grid;
@@ -71,47 +64,47 @@ void SteklovPoincare::apply(const real* v, real* Sv) const {
   // t = -K_ic v lives on plane 1 (w_ is zero on the x = 0 nodes, so are t's)
   K_.apply_planes(w_.data(), t_.data(), 1, 2);
   for (int a = 0; a < 3; ++a) scale(plane, -1, t_.data() + a * N + plane);
-  solve_interior(t_.data(), z_.data());
+  const SolveStats st = solve_interior(t_.data(), z_.data(), rtol);
   // u = w + z: z vanishes on the constrained plane 0, where w lives
   set_plane(z_.data(), 0, w_.data());
   // Sv = (K u)_c on plane 0, then restore t_'s invariant
   K_.apply_planes(z_.data(), t_.data(), 0, 1);
   gather(t_.data(), Sv);
   set_plane(t_.data(), 0, nullptr);
+  return st;
 }
 
-std::vector<real> SteklovPoincare::condensed_load(real rtol) const {
-  const real keep = inner_rtol_;
-  inner_rtol_ = rtol;
+double SteklovPoincare::apply_work(long long inner_iterations) const {
+  return double(inner_iterations) * (1 + mg_.cycle_work()) + 2.0 / double(P_.grid.nz());
+}
+
+SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b) const {
   std::vector<real> li(P_.load);
   zero_constrained(P_.grid, P_.interior_faces, li.data());
-  solve_interior(li.data(), z_.data());
-  inner_rtol_ = keep;
+  const SolveStats st = solve_interior(li.data(), z_.data(), rtol);
   K_.apply_planes(z_.data(), t_.data(), 0, 1);
-  std::vector<real> b(3 * p_), lc(3 * p_);
+  std::vector<real> lc(3 * p_);
+  b.resize(3 * p_);
   gather(t_.data(), b.data());
   set_plane(t_.data(), 0, nullptr);
   gather(P_.load.data(), lc.data());
   for (index i = 0; i < 3 * p_; ++i) b[i] = lc[i] - b[i];
-  return b;
+  return st;
 }
 
-std::vector<real> SteklovPoincare::recover(const real* uc, real rtol) const {
+SolveStats SteklovPoincare::recover(const real* uc, real rtol, std::vector<real>& u) const {
   // rhs = l_i - K_ic u_c (K_ic u_c lives on plane 1); u = w + K_ii^{-1} rhs.
   // Reuses w_ and t_ (no extra full-size vectors at peak), then restores t_.
   const index n = 3 * P_.nodes();
-  std::vector<real> u(n);
+  u.resize(n);
   scatter(uc, w_.data());
   K_.apply_planes(w_.data(), t_.data(), 1, 2);
   xpay(n, P_.load.data(), -1, t_.data());
   zero_constrained(P_.grid, P_.interior_faces, t_.data());
-  const real keep = inner_rtol_;
-  inner_rtol_ = rtol;
-  solve_interior(t_.data(), u.data());
-  inner_rtol_ = keep;
+  const SolveStats st = solve_interior(t_.data(), u.data(), rtol);
   set_plane(u.data(), 0, w_.data());
   fill<real>(n, 0, t_.data());
-  return u;
+  return st;
 }
 
 }  // namespace tresca

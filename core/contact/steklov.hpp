@@ -14,6 +14,11 @@
 // DATA LAYOUT: contact vectors are SoA of 3 blocks of p values
 // [u_x(0..p-1) | u_y | u_z], contact node c as in problem.hpp.
 // Cost per apply: one inner MG-CG solve (dominant) + 2 plane applies.
+//
+// State: the operator is immutable after construction. Every call takes the
+// inner solve's relative tolerance and returns that solve's SolveStats (the
+// caller counts its own work); the full-size work vectors are scratch only
+// (one call at a time per object).
 #pragma once
 #include <vector>
 
@@ -23,27 +28,22 @@
 
 namespace tresca {
 
-struct InnerStats {
-  long long solves = 0, iterations = 0, failures = 0;
-  SolveReason last_failure = SolveReason::converged;
-};
-
-class SteklovPoincare : public LinearOperator {
+class SteklovPoincare {
  public:
   SteklovPoincare(const Problem& P, const MGOptions& mg = {});
-  index size() const override { return 3 * p_; }
-  void apply(const real* v, real* Sv) const override;
+  index size() const { return 3 * p_; }
+  // Sv = S v with the inner K_ii solve to relative tolerance rtol
+  SolveStats apply(const real* v, real* Sv, real rtol) const;
+  // b = b̃ (3p) with the inner solve to relative tolerance rtol
+  SolveStats condensed_load(real rtol, std::vector<real>& b) const;
+  // u = full SoA displacement (3N) from contact values u_c
+  SolveStats recover(const real* uc, real rtol, std::vector<real>& u) const;
 
-  // b̃ with an inner solve to relative tolerance rtol
-  std::vector<real> condensed_load(real rtol) const;
-  // full SoA displacement (3N) from contact values u_c
-  std::vector<real> recover(const real* uc, real rtol) const;
-
-  // relative tolerance of the inner solve in apply (may be changed between applies)
-  void set_inner_rtol(real r) const { inner_rtol_ = r; }
-  real inner_rtol() const { return inner_rtol_; }
-  const InnerStats& stats() const { return stats_; }
   const Multigrid& interior_multigrid() const { return mg_; }  // its options() also serve the Newton step
+  // work of one apply in fine-grid matvec equivalents, given the inner CG
+  // iterations it took: each iteration one K_ii apply and one V-cycle, plus
+  // the two plane applies around the solve
+  double apply_work(long long inner_iterations) const;
   const ElasticityOperator& K() const { return K_; }
   const Problem& problem() const { return P_; }
 
@@ -52,7 +52,7 @@ class SteklovPoincare : public LinearOperator {
   void gather(const real* full, real* vc) const;
 
  private:
-  SolveStats solve_interior(const real* rhs, real* z) const;
+  SolveStats solve_interior(const real* rhs, real* z, real rtol) const;
   // plane iz of all 3 components of v := src's (or 0 if src is null)
   void set_plane(real* v, index iz, const real* src) const;
 
@@ -60,9 +60,7 @@ class SteklovPoincare : public LinearOperator {
   index p_;
   ElasticityOperator K_;       // faces x0
   Multigrid mg_;               // K_ii hierarchy, faces x0 | z0
-  mutable real inner_rtol_ = 1e-10;
-  mutable InnerStats stats_;
-  mutable CGWorkspace ws_;
+  mutable CGWorkspace ws_;  // scratch
   mutable std::vector<real> w_, t_, z_;
 };
 

@@ -14,7 +14,7 @@ void ElasticityOperator::apply_planes(const real* x, real* y, index z_begin, ind
   const GridDims& g = k_.g;
   {
     const double nodes = double(g.nx()) * double(g.ny()) * double(z_end - z_begin);
-    ScopedTimer t(Kernel::apply, nodes * kApplyCost, nodes);
+    ScopedTimer t(Kernel::apply, nodes * kApplyCost);
     elasticity_apply(k_, x, y, z_begin, z_end);
   }
   if (!B_.empty() && z_begin == 0 && z_end > 0) {
@@ -28,7 +28,7 @@ void ElasticityOperator::residual(const real* b, const real* x, real* r) const {
   const GridDims& g = k_.g;
   {
     const double nodes = double(g.nodes());
-    ScopedTimer t(Kernel::apply, nodes * kResidualCost, nodes);
+    ScopedTimer t(Kernel::apply, nodes * kResidualCost);
     elasticity_apply(k_, x, r, 0, g.nz(), b);
   }
   if (!B_.empty()) {

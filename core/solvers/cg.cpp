@@ -18,21 +18,34 @@ const char* to_string(SolveReason r) {
   return "?";
 }
 
-SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, real* x, const CGOptions& opt,
-               CGWorkspace& ws) {
+namespace {
+
+// The CG iteration; `side` is the operator with side products, or null.
+SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side, const LinearOperator* M,
+                    const real* b, real* x, real* side_x, const CGOptions& opt, CGWorkspace& ws) {
   const index n = A.size();
   ws.r.resize(n);
   ws.z.resize(n);
   ws.p.resize(n);
   ws.q.resize(n);
-  real *r = ws.r.data(), *z = ws.z.data(), *p = ws.p.data(), *q = ws.q.data();
+  if (side) ws.s.resize(side->side_size());
+  real *r = ws.r.data(), *z = ws.z.data(), *p = ws.p.data(), *q = ws.q.data(), *sp = ws.s.data();
   SolveStats st;
+  auto apply = [&](const real* in, real* out) {
+    st.operator_applications += 1;
+    if (side)
+      side->apply(in, out, sp);
+    else
+      A.apply(in, out);
+  };
   st.rhs_norm = norm2(n, b);
   if (opt.zero_initial_guess) {
     fill<real>(n, 0, x);
     copy(n, b, r);
+    if (side) fill<real>(side->side_size(), 0, side_x);
   } else {
-    A.apply(x, q);
+    apply(x, q);
+    if (side) copy(side->side_size(), sp, side_x);
     copy(n, b, r);
     axpy(n, -1, q, r);
   }
@@ -46,6 +59,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
   if (st.residual <= target) return st;
   if (opt.on_residual) opt.on_residual(st.residual);
   auto precondition = [&] {
+    st.preconditioner_applications += 1;
     if (M)
       M->apply(r, z);
     else
@@ -59,7 +73,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
       st.reason = std::isfinite(rz) ? SolveReason::breakdown : SolveReason::non_finite;
       return st;
     }
-    A.apply(p, q);
+    apply(p, q);
     if (opt.abort_if && opt.abort_if()) {
       st.reason = SolveReason::aborted;
       return st;
@@ -74,7 +88,7 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
       return st;
     }
     const real alpha = rz / pq;
-    if (opt.on_step) opt.on_step(alpha);
+    if (side) axpy(side->side_size(), alpha, sp, side_x);
     {
       ScopedTimer t(Kernel::vector, n * kCgUpdateCost);
       rr = cg_update(n, alpha, p, q, x, r);
@@ -95,6 +109,18 @@ SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, 
   }
   st.reason = SolveReason::max_iterations;
   return st;
+}
+
+}  // namespace
+
+SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, real* x, const CGOptions& opt,
+               CGWorkspace& ws) {
+  return pcg_impl(A, nullptr, M, b, x, nullptr, opt, ws);
+}
+
+SolveStats pcg(const LinearOperatorWithSide& A, const LinearOperator* M, const real* b, real* x, real* side_x,
+               const CGOptions& opt, CGWorkspace& ws) {
+  return pcg_impl(A, &A, M, b, x, side_x, opt, ws);
 }
 
 }  // namespace tresca

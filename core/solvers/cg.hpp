@@ -23,6 +23,8 @@ const char* to_string(SolveReason r);
 
 struct SolveStats {
   int iterations = 0;
+  int operator_applications = 0;        // applications of A (the work, with those of M)
+  int preconditioner_applications = 0;  // applications of M
   real residual = 0;          // final ||r||
   real initial_residual = 0;  // ||b - A x0||
   real rhs_norm = 0;          // ||b||
@@ -35,9 +37,6 @@ struct CGOptions {
   real atol = 0;
   int max_iterations = 1000;
   bool zero_initial_guess = true;  // otherwise x holds the initial guess
-  // called after each step x += alpha p, right after A was applied to p (lets
-  // a caller accumulate side products of that apply, e.g. S x += alpha S p)
-  std::function<void(real alpha)> on_step;
   // called with ||r|| of the initial residual and after every update (lets an
   // inexactly applied A relax its accuracy as the residual falls)
   std::function<void(real rnorm)> on_residual;
@@ -47,10 +46,14 @@ struct CGOptions {
 
 // Work vectors kept by the caller so repeated solves do not allocate.
 struct CGWorkspace {
-  std::vector<real> r, z, p, q;
+  std::vector<real> r, z, p, q, s;
 };
 
 SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, real* x, const CGOptions& opt,
                CGWorkspace& ws);
+// The same, and side_x = B x for the solution x (operator.hpp): B p comes with
+// every A p, and side_x += alpha B p with every step x += alpha p.
+SolveStats pcg(const LinearOperatorWithSide& A, const LinearOperator* M, const real* b, real* x, real* side_x,
+               const CGOptions& opt, CGWorkspace& ws);
 
 }  // namespace tresca

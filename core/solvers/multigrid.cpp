@@ -188,7 +188,7 @@ void Multigrid::residual(int l, const T* b, const T* x, T* r) const {
   const GridDims& g = w.k.g;
   {
     const double nodes = double(g.nodes());
-    ScopedTimer t(Kernel::apply, nodes * in_precision<T>(kResidualCost), nodes);
+    ScopedTimer t(Kernel::apply, nodes * in_precision<T>(kResidualCost));
     elasticity_apply<T>(w.k, x, r, 0, g.nz(), b);
   }
   if (!w.B.empty()) {
@@ -270,6 +270,12 @@ void Multigrid::apply(const real* r, real* z) const {
     vcycle<float>(0);
     convert<double>(n, w.x.data(), z);
   }
+}
+
+double Multigrid::cycle_work() const {
+  double w = 0;
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) w += double(levels_[l].A.grid().nodes());
+  return 2.0 * opt_.degree * w / double(levels_[0].A.grid().nodes());
 }
 
 std::string Multigrid::describe() const {

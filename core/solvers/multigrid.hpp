@@ -61,6 +61,10 @@ class Multigrid : public LinearOperator {
 
   int num_levels() const { return int(levels_.size()); }
   const MGOptions& options() const { return opt_; }
+  // work of one V-cycle in applications of the finest operator: 2*degree
+  // residual applies on every level but the coarsest, weighted by its size
+  // (transfers, vector updates and the coarse solve not counted)
+  double cycle_work() const;
   // the (double-precision) operator of a level; op(0) is the operator this
   // V-cycle preconditions
   const ElasticityOperator& op(int level) const { return levels_[level].A; }

@@ -12,4 +12,15 @@ class LinearOperator {
   virtual void apply(const real* x, real* y) const = 0;
 };
 
+// An operator y = A x whose evaluation also yields s = B x for a second linear
+// map B (size side_size()) at no extra cost, e.g. A = mask(S + H) yields S x.
+// CG (cg.hpp) then returns B x of its solution as well, accumulated from the
+// products of its own iterations (no extra application of B).
+class LinearOperatorWithSide : public LinearOperator {
+ public:
+  virtual index side_size() const = 0;
+  virtual void apply(const real* x, real* y, real* s) const = 0;
+  using LinearOperator::apply;
+};
+
 }  // namespace tresca

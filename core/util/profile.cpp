@@ -26,14 +26,13 @@ double peak_memory_bytes() {
   return double(ru.ru_maxrss) * 1024.0;  // Linux reports kilobytes
 }
 
-void profile_add(Kernel k, double seconds, double bytes, double flops, double items) {
+void profile_add(Kernel k, double seconds, double bytes, double flops) {
   // called from the serial driver thread only (kernels parallelise inside)
   ProfileEntry& e = g_entries[int(k)];
   e.calls += 1;
   e.seconds += seconds;
   e.bytes += bytes;
   e.flops += flops;
-  e.items += items;
 }
 
 ProfileEntry profile_get(Kernel k) { return g_entries[int(k)]; }

@@ -17,10 +17,9 @@ const char* kernel_name(Kernel k);
 struct ProfileEntry {
   long long calls = 0;
   double seconds = 0, bytes = 0, flops = 0;
-  double items = 0;  // work items (grid nodes for the apply), for fine-matvec equivalents
 };
 
-void profile_add(Kernel k, double seconds, double bytes, double flops, double items = 0);
+void profile_add(Kernel k, double seconds, double bytes, double flops);
 ProfileEntry profile_get(Kernel k);
 void profile_reset();
 // Table with calls, time, share of `total_seconds`, GB/s and GFLOP/s.
@@ -45,16 +44,15 @@ double peak_memory_bytes();
 
 class ScopedTimer {
  public:
-  // cost: the kernel's modelled traffic and flops (n * kSomeCost); items: work items
-  explicit ScopedTimer(Kernel k, Cost cost = {}, double items = 0)
-      : k_(k), b_(cost.bytes), f_(cost.flops), n_(items), t0_(wall_time()) {}
-  ~ScopedTimer() { profile_add(k_, wall_time() - t0_, b_, f_, n_); }
+  // cost: the kernel's modelled traffic and flops (n * kSomeCost)
+  explicit ScopedTimer(Kernel k, Cost cost = {}) : k_(k), b_(cost.bytes), f_(cost.flops), t0_(wall_time()) {}
+  ~ScopedTimer() { profile_add(k_, wall_time() - t0_, b_, f_); }
   ScopedTimer(const ScopedTimer&) = delete;
   ScopedTimer& operator=(const ScopedTimer&) = delete;
 
  private:
   Kernel k_;
-  double b_, f_, n_, t0_;
+  double b_, f_, t0_;
 };
 
 }  // namespace tresca
