@@ -9,6 +9,7 @@
 
 #include "core/io/cli.hpp"
 #include "core/io/output.hpp"
+#include "core/io/summary.hpp"
 #include "core/util/profile.hpp"
 #include "core/contact/run.hpp"
 #include "kernels/simd.hpp"
@@ -55,41 +56,6 @@ const PaperRow* paper_row(int level) {
   for (const auto& r : kPaper)
     if (r.level == level) return &r;
   return nullptr;
-}
-
-std::string summary_json(const ProblemSpec& spec, const RunResult& R, int threads, const RunOptions& opt) {
-  const double eps = opt.newton.eps;
-  const Problem& P = *R.problem;
-  const FinalReport& F = R.report;
-  const NewtonResult& N = R.newton;
-  Json times, counts, contact, kkt;
-  times.num("setup", R.times.setup).num("condense", R.times.condense).num("solve", R.times.solve)
-      .num("recover", R.times.recover).num("total", R.times.total);
-  counts.integer("inner_iterations", R.inner_iterations).integer("outer_iterations", N.outer_iterations)
-      .integer("operator_applications", N.operator_applications)
-      .integer("newton_inner_iterations", N.inner_iterations)
-      .integer("outer_limit_hits", N.outer_limit_hits)
-      .num("fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step());
-  contact.integer("active", F.active).integer("separated", F.separated).integer("sticking", F.sticking)
-      .integer("sliding", F.sliding).num("ux_min", F.ux_min).num("uz_max", F.uz_max).num("lambda_sum", F.lambda_sum);
-  kkt.num("equilibrium", F.equilibrium).num("uz_violation", F.uz_violation).num("lambda_violation", F.lambda_violation)
-      .num("complementarity", F.complementarity).num("friction_bound", F.friction_bound)
-      .num("friction_direction", F.friction_direction).num("stick_slip", F.stick_slip);
-  Json j;
-  if (spec.level >= 0)
-    j.integer("level", spec.level);
-  else
-    j.null("level");
-  j.raw("dims", "[" + std::to_string(spec.ex) + ", " + std::to_string(spec.ey) + ", " + std::to_string(spec.ez) + "]")
-      .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
-      .num("phi", spec.phi).num("eps", eps).integer("threads", threads).str("build", build_info())
-      .str("mg_precision", to_string(opt.mg.precision)).integer("newton_iterations", N.iterations)
-      .boolean("converged", N.converged()).str("reason", to_string(N.reason))
-      .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())
-      .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
-      .raw("times", times.render()).raw("counts", counts.render()).raw("contact", contact.render())
-      .raw("kkt", kkt.render()).num("peak_memory_bytes", R.peak_memory);
-  return j.render();
 }
 
 }  // namespace
@@ -185,7 +151,7 @@ int main(int argc, char** argv) {
                     R.report.true_residual, R.report.true_residual_relative);
         std::fflush(stdout);
         all = all && R.newton.converged();
-        rows += (rows.size() > 1 ? ",\n " : "") + summary_json(s, R, threads, opt);
+        rows += (rows.size() > 1 ? ",\n " : "") + run_summary(s, R, threads, opt).render();
       }
       if (!json_path.empty()) write_file_atomic(json_path, rows + "]\n");
       return all ? 0 : 1;
@@ -228,7 +194,7 @@ int main(int argc, char** argv) {
                              profile_table(R.times.total).c_str());
     try {
       const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status};
-      if (!json_path.empty()) write_file_atomic(json_path, summary_json(spec, R, threads, opt) + "\n");
+      if (!json_path.empty()) write_file_atomic(json_path, run_summary(spec, R, threads, opt).render() + "\n");
       if (!csv_path.empty()) write_contact_csv(csv_path, *R.problem, cf);
       if (!vtk_path.empty()) {
         const std::string second = write_vtu(vtk_path, *R.problem, R.u_full, cf);

@@ -14,6 +14,7 @@
 
 #include "core/io/cli.hpp"
 #include "core/io/output.hpp"
+#include "core/io/summary.hpp"
 #include "core/util/profile.hpp"
 #include "core/contact/run.hpp"
 #include "kernels/simd.hpp"
@@ -68,17 +69,8 @@ int main(int argc, char** argv) {
                     R.newton.operator_applications, R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9, speedup,
                     R.newton.converged() ? "" : to_string(R.newton.reason));
         std::fflush(stdout);
-        Json times, j;
-        times.num("setup", R.times.setup).num("condense", R.times.condense).num("solve", R.times.solve)
-            .num("recover", R.times.recover).num("total", R.times.total);
-        j.integer("level", L).integer("threads", T).str("build", build_info()).integer("dofs", R.problem->free_dofs()).raw("times", times.render())
-            .integer("newton_iterations", R.newton.iterations).boolean("converged", R.newton.converged())
-            .integer("outer_iterations", R.newton.outer_iterations).integer("inner_iterations", R.inner_iterations)
-            .integer("operator_applications", R.newton.operator_applications)
-            .num("fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step())
-            .num("peak_memory_bytes", R.peak_memory).num("speedup", speedup)
-            .num("true_residual_relative", R.report.true_residual_relative)
-            .num("lambda_sum", R.report.lambda_sum).num("ux_min", R.report.ux_min).num("uz_max", R.report.uz_max);
+        Json j = run_summary(s, R, T, o);
+        j.num("speedup", speedup);
         rows += (rows.size() > 1 ? ",\n " : "") + j.render();
       }
     }

@@ -157,6 +157,14 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
 
 }  // namespace
 
+bool stagnated(const std::vector<real>& h, int w) {
+  const int k = int(h.size());
+  if (k < 2 * w) return false;
+  const real last = *std::max_element(h.end() - w, h.end());
+  const real before = *std::max_element(h.end() - 2 * w, h.end() - w);
+  return last > 0.5 * before;
+}
+
 NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, real phi,
                                const NewtonOptions& opt) {
   const double t0 = wall_time();
@@ -185,8 +193,6 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   if (opt.outer_pc == OuterPreconditioner::multigrid)
     M = std::make_unique<BoundaryPreconditioner>(S, S.interior_multigrid().options());
   CGWorkspace ws;
-  real best = INFINITY;
-  int since_best = 0;
 
   for (int k = 0;; ++k) {
     // 1. approximation step at x = (u, lambda), r = S u - b̃
@@ -209,12 +215,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     if (!std::isfinite(vnorm)) return finish(NewtonReason::non_finite);
     if (vnorm <= opt.eps) return finish(NewtonReason::converged);
     if (k >= opt.max_iterations) return finish(NewtonReason::iteration_limit);
-    if (vnorm < best) {
-      best = vnorm;
-      since_best = 0;
-    } else if (++since_best >= opt.stagnation_window) {
-      return finish(NewtonReason::stagnation);
-    }
+    if (stagnated(R.history, opt.stagnation_window)) return finish(NewtonReason::stagnation);
 
     // 2. linearisation: known increments, free set, H, right-hand side
     const bool any_known = linearise(p, phi, R.status, v, d, L);

@@ -51,7 +51,9 @@ struct NewtonOptions {
   OuterPreconditioner outer_pc = OuterPreconditioner::multigrid;
   int max_iterations = 50;
   real step_accuracy = 1e-3;  // late steps are solved to this fraction of ||v̂_k||
-  int stagnation_window = 8;  // stop if ||v̂|| has not decreased over this many steps
+  // stop when the largest ||v̂|| of the last `stagnation_window` steps is not
+  // below half the largest of the window before (a lucky dip does not count)
+  int stagnation_window = 4;
   std::function<void(const NewtonProgress&)> progress;
   // optional initial iterate (default x0 = 0): u0 (3p) and lambda0 (p);
   // S u0 is then formed with a tight inner solve
@@ -72,6 +74,13 @@ struct NewtonResult {
   double fine_matvecs = 0;
   bool converged() const { return reason == NewtonReason::converged; }
 };
+
+// No progress over the history h of ||v̂||: the largest value of the last w
+// steps is not below half the largest of the w steps before. The method is not
+// monotone in ||v̂|| (a step may land near a solution with the wrong active
+// set and the next leave it), so progress is judged by window maxima, which an
+// isolated dip does not move; at the round-off floor the maxima stay flat.
+bool stagnated(const std::vector<real>& h, int w);
 
 NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, real phi,
                                const NewtonOptions& opt);

@@ -1,0 +1,46 @@
+#include "core/io/summary.hpp"
+
+#include <cmath>
+
+#include "core/io/output.hpp"
+#include "kernels/simd.hpp"
+
+namespace tresca {
+
+Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const RunOptions& opt) {
+  const double eps = opt.newton.eps;
+  const Problem& P = *R.problem;
+  const FinalReport& F = R.report;
+  const NewtonResult& N = R.newton;
+  Json times, counts, contact, kkt;
+  times.num("setup", R.times.setup).num("condense", R.times.condense).num("solve", R.times.solve)
+      .num("recover", R.times.recover).num("total", R.times.total);
+  counts.integer("inner_iterations", R.inner_iterations).integer("outer_iterations", N.outer_iterations)
+      .integer("operator_applications", N.operator_applications)
+      .integer("newton_inner_iterations", N.inner_iterations)
+      .integer("outer_limit_hits", N.outer_limit_hits)
+      .num("fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step());
+  contact.integer("active", F.active).integer("separated", F.separated).integer("sticking", F.sticking)
+      .integer("sliding", F.sliding).num("ux_min", F.ux_min).num("uz_max", F.uz_max).num("lambda_sum", F.lambda_sum);
+  kkt.num("equilibrium", F.equilibrium).num("uz_violation", F.uz_violation).num("lambda_violation", F.lambda_violation)
+      .num("complementarity", F.complementarity).num("friction_bound", F.friction_bound)
+      .num("friction_direction", F.friction_direction).num("stick_slip", F.stick_slip);
+  Json j;
+  if (spec.level >= 0)
+    j.integer("level", spec.level);
+  else
+    j.null("level");
+  j.raw("dims", "[" + std::to_string(spec.ex) + ", " + std::to_string(spec.ey) + ", " + std::to_string(spec.ez) + "]")
+      .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
+      .num("phi", spec.phi).num("eps", eps).integer("threads", threads).str("build", build_info())
+      .str("mg_precision", to_string(opt.mg.precision)).integer("newton_iterations", N.iterations)
+      .boolean("converged", N.converged()).str("reason", to_string(N.reason))
+      .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())
+      .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
+      .raw("times", times.render()).raw("counts", counts.render()).raw("contact", contact.render())
+      .raw("kkt", kkt.render()).num("peak_memory_bytes", R.peak_memory);
+  return j;
+}
+
+
+}  // namespace tresca

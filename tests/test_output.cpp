@@ -1,0 +1,208 @@
+// What users read, value by value: the contact CSV, both VTU files and the
+// JSON run summary against the solver's own arrays, on a small case where
+// nodes stick, slide and separate. The files are parsed back independently.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/contact/run.hpp"
+#include "core/io/output.hpp"
+#include "core/io/summary.hpp"
+#include "kernels/contact_maps.hpp"
+
+namespace tresca {
+
+namespace {
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// the numbers of the DataArray named `name` (or the first one after `after`)
+std::vector<double> data_array(const std::string& xml, const std::string& name, const std::string& after = "") {
+  size_t at = after.empty() ? xml.find("Name=\"" + name + "\"") : xml.find(after);
+  EXPECT_NE(at, std::string::npos) << name << after;
+  if (at == std::string::npos) return {};
+  at = xml.find('>', after.empty() ? at : xml.find("<DataArray", at)) + 1;
+  const size_t end = xml.find("</DataArray>", at);
+  std::istringstream is(xml.substr(at, end - at));
+  std::vector<double> v;
+  double x;
+  while (is >> x) v.push_back(x);
+  return v;
+}
+
+double json_value(const std::string& j, const std::string& key) {
+  const size_t at = j.find("\"" + key + "\": ");
+  EXPECT_NE(at, std::string::npos) << key;
+  return at == std::string::npos ? NAN : std::strtod(j.c_str() + at + key.size() + 4, nullptr);
+}
+
+// VTK status codes, from the node's status bits (output.hpp)
+int status_code(std::uint8_t s) { return !(s & kContact) ? 1 : (s & kStick) ? 2 : 3; }
+
+class OutputFiles : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    spec_ = new ProblemSpec(spec_for_dims(12, 6, 6));
+    spec_->phi = 3e6;  // 56 in contact, 28 separated, 9 sticking, 75 sliding
+    RunOptions o;
+    R_ = new RunResult(run_tresca(*spec_, o));
+  }
+  static void TearDownTestSuite() {
+    delete R_;
+    delete spec_;
+  }
+  ContactFields fields() const { return {&R_->newton.u, &R_->newton.lambda, &R_->report.r, &R_->report.status}; }
+  static ProblemSpec* spec_;
+  static RunResult* R_;
+};
+ProblemSpec* OutputFiles::spec_ = nullptr;
+RunResult* OutputFiles::R_ = nullptr;
+
+}  // namespace
+
+TEST_F(OutputFiles, TheCaseHasEveryKindOfContactNode) {
+  ASSERT_TRUE(R_->newton.converged());
+  EXPECT_GT(R_->report.sticking, 0);
+  EXPECT_GT(R_->report.sliding, 0);
+  EXPECT_GT(R_->report.separated, 0);
+}
+
+TEST_F(OutputFiles, ContactCsvRowsAreTheSolversValues) {
+  const std::string path = ::testing::TempDir() + "tresca_out.csv";
+  write_contact_csv(path, *R_->problem, fields());
+  std::istringstream is(slurp(path));
+  std::string line;
+  std::getline(is, line);
+  EXPECT_EQ(line, "ix,iy,x,y,ux,uy,uz,lambda,contact,stick");
+  const Problem& P = *R_->problem;
+  const index p = P.contact_nodes();
+  const auto &u = R_->newton.u, &lam = R_->newton.lambda;
+  const auto& st = R_->report.status;
+  index rows = 0;
+  while (std::getline(is, line)) {
+    double v[10];
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", v, v + 1, v + 2, v + 3, v + 4, v + 5,
+                          v + 6, v + 7, v + 8, v + 9),
+              10)
+        << line;
+    const index i = rows++;
+    ASSERT_LT(i, p);
+    const index ix = 1 + i % P.grid.ex, iy = i / P.grid.ex;
+    EXPECT_EQ(v[0], ix);
+    EXPECT_EQ(v[1], iy);
+    EXPECT_NEAR(v[2], P.grid.x0 + ix * P.grid.hx(), 1e-9);
+    EXPECT_NEAR(v[3], P.grid.y0 + iy * P.grid.hy(), 1e-9);
+    // %.17g round-trips doubles exactly
+    EXPECT_EQ(v[4], u[i]) << "u_x of node " << i;
+    EXPECT_EQ(v[5], u[p + i]) << "u_y of node " << i;
+    EXPECT_EQ(v[6], u[2 * p + i]) << "u_z of node " << i;
+    EXPECT_EQ(v[7], lam[i]);
+    EXPECT_EQ(v[8], (st[i] & kContact) ? 1 : 0);
+    EXPECT_EQ(v[9], (st[i] & kStick) ? 1 : 0);
+  }
+  EXPECT_EQ(rows, p);
+}
+
+TEST_F(OutputFiles, VtuHoldsTheSolversFieldsOnPositiveVolumeHexahedra) {
+  const std::string path = ::testing::TempDir() + "tresca_out.vtu";
+  const std::string cpath = write_vtu(path, *R_->problem, R_->u_full, fields());
+  EXPECT_EQ(cpath, ::testing::TempDir() + "tresca_out_contact.vtu");
+  const Problem& P = *R_->problem;
+  const GridDims& g = P.grid;
+  const index N = g.nodes(), p = P.contact_nodes();
+  const std::string v = slurp(path);
+  const auto pts = data_array(v, "", "<Points>");
+  const auto conn = data_array(v, "connectivity");
+  const auto disp = data_array(v, "displacement");
+  const auto force = data_array(v, "contact_force");
+  const auto code = data_array(v, "contact_status");
+  ASSERT_EQ(index(pts.size()), 3 * N);
+  ASSERT_EQ(index(conn.size()), 8 * g.ex * g.ey * g.ez);
+  ASSERT_EQ(index(disp.size()), 3 * N);
+  ASSERT_EQ(index(code.size()), N);
+  // every hexahedron, in VTK's node order, has the brick's volume (Jacobian at its centre)
+  const double vol = g.hx() * g.hy() * g.hz();
+  for (size_t c = 0; c < conn.size() / 8; ++c) {
+    std::array<std::array<double, 3>, 8> q;
+    for (int k = 0; k < 8; ++k)
+      for (int a = 0; a < 3; ++a) q[k][a] = pts[3 * size_t(conn[8 * c + k]) + a];
+    double J[3][3];
+    for (int a = 0; a < 3; ++a) {
+      J[0][a] = (q[1][a] - q[0][a] + q[2][a] - q[3][a] + q[5][a] - q[4][a] + q[6][a] - q[7][a]) / 4;
+      J[1][a] = (q[3][a] - q[0][a] + q[2][a] - q[1][a] + q[7][a] - q[4][a] + q[6][a] - q[5][a]) / 4;
+      J[2][a] = (q[4][a] - q[0][a] + q[5][a] - q[1][a] + q[6][a] - q[2][a] + q[7][a] - q[3][a]) / 4;
+    }
+    const double det = J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) -
+                       J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
+                       J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
+    ASSERT_NEAR(det, vol, 1e-6 * vol) << "cell " << c;
+  }
+  // point data: displacement components of every node, contact values on the contact nodes
+  std::vector<index> cid(N, -1);
+  for (index i = 0; i < p; ++i) cid[P.contact_grid_node(i)] = i;
+  const double us = 1e-11 * std::max(std::abs(R_->report.ux_min), 1e-3);
+  for (index n = 0; n < N; ++n) {
+    for (int a = 0; a < 3; ++a) ASSERT_NEAR(disp[3 * n + a], R_->u_full[a * N + n], us) << "node " << n << " comp " << a;
+    const index i = cid[n];
+    EXPECT_EQ(code[n], i < 0 ? 0 : status_code(R_->report.status[i])) << "node " << n;
+    if (i >= 0) {
+      const double fs = 1e-11 * std::abs(R_->report.lambda_sum);
+      EXPECT_NEAR(force[3 * n], R_->report.r[i], fs);
+      EXPECT_NEAR(force[3 * n + 1], R_->report.r[p + i], fs);
+      EXPECT_NEAR(force[3 * n + 2], R_->newton.lambda[i], fs);
+    }
+  }
+  // the contact face: quads over the bottom plane with the same values
+  const std::string vc = slurp(cpath);
+  const auto cd = data_array(vc, "displacement");
+  const auto cl = data_array(vc, "lambda");
+  const auto cc = data_array(vc, "contact_status");
+  const index M = g.nx() * g.ny();
+  ASSERT_EQ(index(cd.size()), 3 * M);
+  for (index n = 0; n < M; ++n) {
+    for (int a = 0; a < 3; ++a) ASSERT_NEAR(cd[3 * n + a], R_->u_full[a * N + n], us);
+    EXPECT_NEAR(cl[n], cid[n] < 0 ? 0.0 : R_->newton.lambda[cid[n]], 1e-11 * std::abs(R_->report.lambda_sum));
+    EXPECT_EQ(cc[n], cid[n] < 0 ? 0 : status_code(R_->report.status[cid[n]]));
+  }
+}
+
+TEST_F(OutputFiles, JsonSummaryRepeatsTheSolution) {
+  RunOptions o;
+  const std::string j = run_summary(*spec_, *R_, 2, o).render();
+  const auto &u = R_->newton.u, &lam = R_->newton.lambda;
+  const index p = R_->problem->contact_nodes();
+  double lsum = 0, ux_min = INFINITY, uz_max = -INFINITY;
+  for (index i = 0; i < p; ++i) {
+    lsum += lam[i];
+    ux_min = std::min(ux_min, u[i]);
+    uz_max = std::max(uz_max, u[2 * p + i]);
+  }
+  EXPECT_NEAR(json_value(j, "lambda_sum"), lsum, 1e-12 * lsum);
+  EXPECT_EQ(json_value(j, "ux_min"), ux_min);
+  EXPECT_EQ(json_value(j, "uz_max"), uz_max);
+  EXPECT_EQ(json_value(j, "newton_iterations"), R_->newton.iterations);
+  EXPECT_EQ(json_value(j, "contact_nodes"), p);
+  index active = 0, sticking = 0;
+  for (index i = 0; i < p; ++i) {
+    active += (R_->report.status[i] & kContact) ? 1 : 0;
+    sticking += (R_->report.status[i] & kStick) ? 1 : 0;
+  }
+  EXPECT_EQ(json_value(j, "active"), active);
+  EXPECT_EQ(json_value(j, "separated"), p - active);
+  EXPECT_EQ(json_value(j, "sticking"), sticking);
+  EXPECT_EQ(json_value(j, "sliding"), p - sticking);
+  EXPECT_EQ(json_value(j, "final_residual"), R_->newton.history.back());
+}
+
+}  // namespace tresca
