@@ -20,7 +20,7 @@ static const char* kHelp =
 
 int main(int argc, char** argv) {
   try {
-    Args a(argc, argv, {"--level", "--dims", "--E", "--nu", "--phi", "--rtol", "--threads"}, {"--help"});
+    Args a(argc, argv, {"--level", "--dims", "--E", "--nu", "--rtol", "--threads"}, {"--help"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
       return 0;

@@ -31,6 +31,7 @@ inline real node_step(index i, index p, real phi, const real* u, const real* lam
 
 real approximation_step(index p, real phi, const real* u, const real* lambda, const real* r, real* v, real* d,
                         std::uint8_t* status) {
+  TRESCA_ASSERT(p >= 0 && phi >= 0);
   // per-node work in parallel, then the deterministic blocked sum of v.v.
   // (The test oracle is the dense reference Newton in tests/test_newton.cpp.)
 #pragma omp parallel for schedule(static) if (p > 4096)

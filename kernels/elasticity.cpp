@@ -205,6 +205,9 @@ template ElasticityStencilT<double> stencil_in_precision<double>(const Elasticit
 
 template <class T>
 void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_begin, index z_end, const T* b) {
+  TRESCA_ASSERT(0 <= z_begin && z_begin <= z_end && z_end <= k.g.nz());
+  TRESCA_ASSERT(x != y && (b == nullptr || b != y));  // y is written while x and b are read
+  TRESCA_ASSERT(!k.groups.empty());
   const GridDims& g = k.g;
   const index nx = g.nx(), ny = g.ny(), N = g.nodes();
   const index nruns = index(k.run_begin.size()) - 1;

@@ -49,6 +49,7 @@ Transfer build_transfer(const GridDims& fine, const GridDims& coarse) {
 
 template <class T>
 void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool accumulate) {
+  TRESCA_ASSERT(comps >= 1 && comps <= 3 && index(t.axis[0].j0.size()) == t.fine.nx());
   // Per fine row (iy, iz): combine the 4 coarse rows of its y/z support into
   // one coarse-length row buffer (contiguous, vectorised), then interpolate
   // along x from that buffer (it sits in L1): 4 FMAs per coarse node plus
@@ -107,6 +108,7 @@ void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine
 
 template <class T>
 void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) {
+  TRESCA_ASSERT(comps >= 1 && comps <= 3 && index(t.axis[0].tstart.size()) == t.coarse.nx() + 1);
   // Per coarse row (jy, jz): sum the weighted fine rows of its y/z support
   // into one row buffer (contiguous, vectorisable), then gather along x.
   const GridDims &f = t.fine, &c = t.coarse;

@@ -1,11 +1,19 @@
 // Scalar and index types used everywhere. Sizes that exceed 2^31 at large
 // mesh levels (dof counts, flat offsets) are 64-bit.
 #pragma once
+#include <cassert>
 #include <cstdint>
 
 namespace tresca {
 using real = double;
 using index = std::int64_t;
+
+// Contracts. TRESCA_ASSERT: cheap checks at kernel and operator entry points
+// (sizes, ranges, aliasing), compiled out in Release (NDEBUG) so hot paths pay
+// nothing; run the tests in a Debug build to exercise them. Checks at the API
+// boundary (drivers, solvers' public functions) are always on and throw
+// std::invalid_argument naming the value.
+#define TRESCA_ASSERT(cond) assert(cond)
 
 // Modelled cost of a kernel per work item: bytes moved to or from memory (no
 // write-allocate) and flops. Each kernel header states its own, once; the

@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
     const long long level = a.int_value("--level", 10);
     const long long reps = a.int_value("--reps", 20);
     if (reps < 1 || reps > 100000) throw std::invalid_argument("--reps " + a.str("--reps") + " must be in 1..100000");
-    const ProblemSpec spec = spec_for_level(int(level));
+    const ProblemSpec spec = spec_for_level(level);
     check_memory(spec);
     const std::string json = a.str("--json");
     if (!json.empty()) check_writable(json);

@@ -49,8 +49,9 @@ void expect_error(const std::string& args, const std::string& names) {
 
 TEST(ElasticDriver, RejectsBadInputWithOneLineNamingTheValue) {
   expect_error("elastic --level -1", "-1");
-  expect_error("elastic --level 15", "level 15");
-  expect_error("elastic --level 19", "level 19");
+  expect_error("elastic --level 21", "level 21");  // outside the levels that exist
+  expect_error("elastic --level 19", "level 19");  // exists, but needs terabytes
+  expect_error("elastic --phi 1", "--phi");         // elastic has no friction
   expect_error("elastic --nu 0.5", "0.5");
   expect_error("elastic --E -3", "-3");
   expect_error("elastic --E 0", "E = 0");

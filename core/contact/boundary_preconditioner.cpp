@@ -1,5 +1,8 @@
 #include "core/contact/boundary_preconditioner.hpp"
 
+#include <stdexcept>
+#include <string>
+
 namespace tresca {
 
 namespace {
@@ -25,6 +28,9 @@ void BoundaryPreconditioner::update(const std::vector<real>& h, const std::vecto
   const Problem& P = S_.problem();
   const GridDims& g = P.grid;
   const index M = g.nx() * g.ny(), p = P.contact_nodes();
+  if (index(h.size()) != 3 * p || index(fixed.size()) != 3 * p || index(free_mask.size()) != 3 * p)
+    throw std::invalid_argument("BoundaryPreconditioner::update: h, fixed and free must have 3p = " +
+                                std::to_string(3 * p) + " entries");
   std::vector<real> B(4 * M, 0.0);
   for (index c = 0; c < p; ++c) {
     const index n = P.contact_grid_node(c);  // bottom plane: grid node index = plane index

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 #include "kernels/contact_maps.hpp"
 #include "kernels/vector_ops.hpp"
@@ -169,6 +171,14 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
                                const NewtonOptions& opt) {
   const double t0 = wall_time();
   const index p = S.size() / 3, n3 = 3 * p;
+  auto size_error = [&](const char* what, size_t got, index want) {
+    throw std::invalid_argument(std::string("semismooth_newton: ") + what + " has " + std::to_string(got) +
+                                " entries, expected " + std::to_string(want));
+  };
+  if (index(btilde.size()) != n3) size_error("b~", btilde.size(), n3);
+  if (opt.u0 && index(opt.u0->size()) != n3) size_error("u0", opt.u0->size(), n3);
+  if (opt.lambda0 && index(opt.lambda0->size()) != p) size_error("lambda0", opt.lambda0->size(), p);
+  if (!(phi >= 0) || !std::isfinite(phi)) throw std::invalid_argument("semismooth_newton: phi must be >= 0 and finite");
   InnerWork work;
   NewtonResult R;
   R.u.assign(n3, 0);

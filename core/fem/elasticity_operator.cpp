@@ -1,5 +1,8 @@
 #include "core/fem/elasticity_operator.hpp"
 
+#include <stdexcept>
+#include <string>
+
 #include "kernels/boundary_block.hpp"
 #include "core/util/profile.hpp"
 
@@ -39,9 +42,12 @@ void ElasticityOperator::residual(const real* b, const real* x, real* r) const {
 }
 
 void ElasticityOperator::set_bottom_block(std::vector<real> B) {
+  const GridDims& g = k_.g;
+  if (!B.empty() && index(B.size()) != 4 * g.nx() * g.ny())
+    throw std::invalid_argument("bottom block has " + std::to_string(B.size()) + " entries, expected 4 x " +
+                                std::to_string(g.nx() * g.ny()));
   B_ = std::move(B);
   if (B_.empty()) return;
-  const GridDims& g = k_.g;
   const index M = g.nx() * g.ny();
   for (index iy = 0; iy < g.ny(); ++iy)
     for (index ix = 0; ix < g.nx(); ++ix)

@@ -15,15 +15,15 @@ std::array<index, 3> level_dims(int level) {
   return {index(std::ceil(4 * s - 1e-9)), index(std::ceil(2 * s - 1e-9)), index(std::ceil(2 * s - 1e-9))};
 }
 
-ProblemSpec spec_for_level(int level) {
-  if (level < 0 || level > 20) {
+ProblemSpec spec_for_level(long long level) {
+  if (level < 0 || level > kMaxLevel) {
     std::ostringstream os;
-    os << "mesh level " << level << " is out of range (0..20)";
+    os << "mesh level " << level << " is out of range (0.." << kMaxLevel << ")";
     fail(os.str());
   }
   ProblemSpec s;
-  s.level = level;
-  auto d = level_dims(level);
+  s.level = int(level);
+  auto d = level_dims(int(level));
   s.ex = d[0];
   s.ey = d[1];
   s.ez = d[2];

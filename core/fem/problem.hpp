@@ -37,10 +37,14 @@ struct ProblemSpec {
   index free_dofs() const { return 3 * (nodes() - (ey + 1) * (ez + 1)); }  // all but the x = 0 face
 };
 
+// Mesh levels 0..kMaxLevel exist (level 20: 3e10 dofs); whether one fits in
+// memory is a separate check (cli.hpp: check_memory).
+constexpr int kMaxLevel = 20;
 // Element counts of mesh level l (method.md §1).
 std::array<index, 3> level_dims(int level);
-// Throws std::invalid_argument naming the value if the level is out of range.
-ProblemSpec spec_for_level(int level);
+// The one place that checks the level range: throws std::invalid_argument
+// naming the value if the level is outside 0..kMaxLevel.
+ProblemSpec spec_for_level(long long level);
 ProblemSpec spec_for_dims(index ex, index ey, index ez);
 // Throws std::invalid_argument naming the offending value.
 void validate(const ProblemSpec& s);

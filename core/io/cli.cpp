@@ -80,9 +80,7 @@ ProblemSpec spec_from_args(const Args& a, int default_level) {
     if (e[0] < 1 || e[1] < 1 || e[2] < 1) fail("--dims '" + d + "': every element count must be >= 1");
     s = spec_for_dims(e[0], e[1], e[2]);
   } else {
-    const long long L = a.int_value("--level", default_level);
-    if (L < 0 || L > 20) fail("--level " + std::to_string(L) + " is out of range (0..20)");
-    s = spec_for_level(int(L));
+    s = spec_for_level(a.int_value("--level", default_level));
   }
   s.E = a.real_value("--E", s.E);
   s.nu = a.real_value("--nu", s.nu);
@@ -102,7 +100,9 @@ std::vector<int> parse_level_range(const std::string& s) {
     if (dash != '-' || !(is >> b)) fail("level range '" + s + "' is malformed (expected e.g. 1-8)");
   }
   if (!is.eof() && is.peek() != EOF) fail("level range '" + s + "' is malformed (expected e.g. 1-8)");
-  if (a < 0 || b > 20 || a > b) fail("level range '" + s + "' must satisfy 0 <= first <= last <= 20");
+  if (a > b) fail("level range '" + s + "' must satisfy first <= last");
+  spec_for_level(a);  // throws for a level outside the range
+  spec_for_level(b);
   std::vector<int> r;
   for (int l = a; l <= b; ++l) r.push_back(l);
   return r;

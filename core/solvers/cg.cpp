@@ -1,6 +1,8 @@
 #include "core/solvers/cg.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
@@ -24,6 +26,11 @@ namespace {
 SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side, const LinearOperator* M,
                     const real* b, real* x, real* side_x, const CGOptions& opt, CGWorkspace& ws) {
   const index n = A.size();
+  if (M && M->size() != n)
+    throw std::invalid_argument("pcg: preconditioner size " + std::to_string(M->size()) + " differs from operator size " +
+                                std::to_string(n));
+  if (!(opt.rtol >= 0) || !(opt.atol >= 0) || opt.max_iterations < 0)
+    throw std::invalid_argument("pcg: tolerances must be >= 0 and max_iterations >= 0");
   ws.r.resize(n);
   ws.z.resize(n);
   ws.p.resize(n);
