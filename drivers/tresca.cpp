@@ -61,6 +61,7 @@ const PaperRow* paper_row(int level) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  default_wait_policy(argv);
   ProblemSpec spec;
   RunOptions opt;
   int threads = 1;

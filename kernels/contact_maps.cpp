@@ -34,7 +34,7 @@ real approximation_step(index p, real phi, const real* u, const real* lambda, co
   TRESCA_ASSERT(p >= 0 && phi >= 0);
   // per-node work in parallel, then the deterministic blocked sum of v.v.
   // (The test oracle is the dense reference Newton in tests/test_newton.cpp.)
-#pragma omp parallel for schedule(static) if (p > 4096)
+#pragma omp parallel for schedule(static) if (worth_threads(double(p) * kApproximationStepCost))
   for (index i = 0; i < p; ++i) node_step(i, p, phi, u, lambda, r, v, d, status);
   return dot(4 * p, v, v);
 }

@@ -217,7 +217,8 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_
   const index nthreads = omp_get_max_threads();
   const index nbands = std::max<index>(1, nthreads * ((ny + nthreads * kBand - 1) / (nthreads * kBand)));
   const index band = (ny + nbands - 1) / nbands;
-#pragma omp parallel for schedule(static)
+  const double nodes = double(nx) * double(ny) * double(z_end - z_begin);
+#pragma omp parallel for schedule(static) if (worth_threads(nodes * in_precision<T>(kApplyCost)))
   for (index bnd = 0; bnd < nbands; ++bnd)
     for (index iz = z_begin; iz < z_end; ++iz)
       for (index iy = bnd * band; iy < std::min(ny, (bnd + 1) * band); ++iy) {
@@ -288,7 +289,7 @@ void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, in
 void elasticity_diagonal(const ElasticityStencil& k, real* d) {
   const GridDims& g = k.g;
   const index N = g.nodes();
-#pragma omp parallel for collapse(2) schedule(static)
+#pragma omp parallel for collapse(2) schedule(static) if (worth_threads(double(N) * Cost{24, 0}))
   for (index iz = 0; iz < g.nz(); ++iz)
     for (index iy = 0; iy < g.ny(); ++iy)
       for (index ix = 0; ix < g.nx(); ++ix) {

@@ -57,7 +57,7 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
   const GridDims &f = t.fine, &c = t.coarse;
   const index Nf = f.nodes(), Nc = c.nodes(), cnx = c.nx(), cny = c.ny(), fnx = f.nx();
   const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
-#pragma omp parallel
+#pragma omp parallel if (worth_threads(double(comps) * double(Nf) * in_precision<T>(kProlongateCost)))
   {
     std::vector<T> row(cnx);  // one buffer per thread, allocated once per call
     T* s = row.data();
@@ -114,7 +114,7 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) 
   const GridDims &f = t.fine, &c = t.coarse;
   const index Nf = f.nodes(), Nc = c.nodes(), fnx = f.nx();
   const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
-#pragma omp parallel
+#pragma omp parallel if (worth_threads(double(comps) * double(Nf) * in_precision<T>(kRestrictCost)))
   {
     std::vector<T> row(fnx);  // one buffer per thread, allocated once per call
 #pragma omp for collapse(2) schedule(static)

@@ -23,6 +23,13 @@ struct Cost {
 };
 constexpr Cost operator*(double n, Cost c) { return {n * c.bytes, n * c.flops}; }
 constexpr Cost operator+(Cost a, Cost b) { return {a.bytes + b.bytes, a.flops + b.flops}; }
+// When a kernel starts threads: only if its modelled work is worth it. A
+// parallel region costs a few microseconds (more when the threads have gone
+// to sleep); 2e5 bytes + flops is about 20 us of one core's work. Every
+// kernel applies this one rule to its own Cost (an OpenMP `if` clause).
+constexpr double kParallelWork = 2e5;
+constexpr bool worth_threads(Cost c) { return c.bytes + c.flops >= kParallelWork; }
+
 // the cost models are stated for double fields; fields of T move sizeof(T)/8 of the bytes
 template <class T>
 constexpr Cost in_precision(Cost c) {

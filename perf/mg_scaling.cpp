@@ -13,6 +13,7 @@
 using namespace tresca;
 
 int main(int argc, char** argv) {
+  default_wait_policy(argv);
   try {
     Args a(argc, argv, {"--levels", "--rtol", "--threads", "--json", "--precision"}, {"--help"});
     if (a.has("--help")) {

@@ -99,6 +99,7 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
+  default_wait_policy(argv);
   try {
     Args a(argc, argv, {"--level", "--threads", "--reps", "--json"}, {"--help"});
     if (a.has("--help")) {

@@ -22,6 +22,7 @@
 using namespace tresca;
 
 int main(int argc, char** argv) {
+  default_wait_policy(argv);
   try {
     Args a(argc, argv, {"--levels", "--threads", "--phi", "--json"}, {"--help"});
     if (a.has("--help")) {

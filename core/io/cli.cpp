@@ -120,6 +120,12 @@ void check_memory(const ProblemSpec& s) {
   }
 }
 
+void default_wait_policy(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY")) return;
+  setenv("OMP_WAIT_POLICY", "passive", 0);
+  execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
+}
+
 int apply_threads(const Args& a) {
   if (a.has("--threads")) {
     const long long t = a.int_value("--threads", 1);

@@ -30,6 +30,14 @@ ProblemSpec spec_from_args(const Args& a, int default_level);
 std::vector<int> parse_level_range(const std::string& s);
 // throws if the estimated memory of a run exceeds the machine's physical memory
 void check_memory(const ProblemSpec& s);
+// The drivers' OpenMP default: threads that wait passively (sleep) instead of
+// spinning. Spinning is 4% faster on an idle machine at level 10, but when
+// another process holds a core the spinning threads slow a run by 2-4x
+// (perf/RESULTS.md). libgomp reads OMP_WAIT_POLICY once, when it is loaded, so
+// if the variable is unset this re-executes the program once with
+// OMP_WAIT_POLICY=passive; a user's own setting is always kept. Call it first
+// in main.
+void default_wait_policy(char** argv);
 // --threads N (else OMP_NUM_THREADS / all cores); returns the thread count in use
 int apply_threads(const Args& a);
 std::string dims_string(const ProblemSpec& s);
