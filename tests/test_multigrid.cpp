@@ -85,6 +85,42 @@ TEST(MultigridVCycle, IsSymmetricInBothPrecisions) {
   }
 }
 
+TEST(MultigridCG, HierarchyIsSharedAndTheOperatorComesFromItsDescription) {
+  // one GridHierarchy, two operators: K_ii of the benchmark, and K with only
+  // x = 0 fixed, another material and a bottom-face block (the Newton-step
+  // preconditioner's kind); both preconditioned CG solves converge fast
+  const Problem P = make_problem(spec_for_dims(17, 9, 9));
+  MGOptions mo;
+  mo.coarse_nodes = 100;
+  const auto grids = GridHierarchy::build(P.grid, mo.coarse_nodes);
+  ASSERT_GE(grids->grids.size(), 3u);
+  Multigrid a(grids, elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mo);
+  Multigrid b(grids, elasticity_on(kFaceX0, 7e10, 0.33), mo);
+  EXPECT_EQ(a.hierarchy().get(), b.hierarchy().get());
+  const index M = P.grid.nx() * P.grid.ny();
+  std::vector<real> B(4 * M, 0.0);
+  for (index n = 0; n < M; ++n) B[n] = B[2 * M + n] = B[3 * M + n] = 1e9;
+  b.set_bottom_block(B);
+  for (Multigrid* mg : {&a, &b}) {
+    auto rhs = test::random_vector(P.dofs(), 41);
+    zero_constrained(mg->op(0).grid(), mg->op(0).faces(), rhs.data());
+    std::vector<real> x(P.dofs());
+    CGOptions o;
+    o.rtol = 1e-10;
+    CGWorkspace ws;
+    const SolveStats st = pcg(mg->op(0), mg, rhs.data(), x.data(), o, ws);
+    ASSERT_TRUE(st.ok()) << to_string(st.reason);
+    EXPECT_LT(st.iterations, 20);
+    std::vector<real> r(P.dofs());
+    mg->op(0).residual(rhs.data(), x.data(), r.data());
+    EXPECT_LT(norm2(P.dofs(), r.data()), 1e-9 * norm2(P.dofs(), rhs.data()));
+  }
+  // an operator that does not live on the hierarchy's grids is refused
+  const GridDims other = test::prism(5, 3, 3);
+  EXPECT_THROW(Multigrid(grids, [&](const GridDims&) { return ElasticityOperator(other, kFaceX0, 1, 0.3); }, mo),
+               std::invalid_argument);
+}
+
 TEST(MultigridCG, IterationCountIsMeshIndependent) {
   // coarse_nodes = 100 makes every one of these a genuine multilevel cycle
   int its[3];

@@ -12,7 +12,9 @@ constexpr real kPenalty = 1e4;
 }  // namespace
 
 BoundaryPreconditioner::BoundaryPreconditioner(const SteklovPoincare& S, const MGOptions& mg)
-    : S_(S), mg_(S.problem().grid, S.problem().dirichlet_faces, S.problem().spec.E, S.problem().spec.nu, mg) {
+    : S_(S),
+      mg_(S.interior_multigrid().hierarchy(),  // the K_ii solver's grids and transfers
+          elasticity_on(S.problem().dirichlet_faces, S.problem().spec.E, S.problem().spec.nu), mg) {
   const GridDims& g = S.problem().grid;
   const index M = g.nx() * g.ny(), N = g.nodes();
   const std::vector<real> d = mg_.op(0).diagonal();

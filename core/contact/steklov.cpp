@@ -12,7 +12,7 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg)
     : P_(P),
       p_(P.contact_nodes()),
       K_(P.grid, P.dirichlet_faces, P.spec.E, P.spec.nu),
-      mg_(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mg) {
+      mg_(GridHierarchy::build(P.grid, mg.coarse_nodes), elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mg) {
   const index n = 3 * P.nodes();
   w_.assign(n, 0);
   t_.assign(n, 0);

@@ -34,17 +34,35 @@ GridDims coarsen(const GridDims& g) {
 
 const char* to_string(Precision p) { return p == Precision::single_precision ? "single" : "double"; }
 
-Multigrid::Multigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt) : opt_(opt) {
+std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, index coarse_nodes) {
+  auto h = std::make_shared<GridHierarchy>();
   GridDims g = fine;
   for (;;) {
-    Level lv;
-    lv.A = ElasticityOperator(g, faces, E, nu);
-    const bool last = g.nodes() <= opt.coarse_nodes || (g.ex == 1 && g.ey == 1 && g.ez == 1);
-    const GridDims coarse = last ? g : coarsen(g);
-    if (!last) lv.to_coarse = build_transfer(g, coarse);
-    levels_.push_back(std::move(lv));
-    if (last) break;
+    h->grids.push_back(g);
+    if (g.nodes() <= coarse_nodes || (g.ex == 1 && g.ey == 1 && g.ez == 1)) break;
+    const GridDims coarse = coarsen(g);
+    h->to_coarse.push_back(build_transfer(g, coarse));
     g = coarse;
+  }
+  return h;
+}
+
+Rediscretisation elasticity_on(unsigned faces, real E, real nu) {
+  return [=](const GridDims& g) { return ElasticityOperator(g, faces, E, nu); };
+}
+
+Multigrid::Multigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt)
+    : Multigrid(GridHierarchy::build(fine, opt.coarse_nodes), elasticity_on(faces, E, nu), opt) {}
+
+Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt)
+    : opt_(opt), grids_(std::move(grids)) {
+  if (!grids_ || grids_->grids.empty()) throw std::invalid_argument("multigrid: empty grid hierarchy");
+  for (const GridDims& g : grids_->grids) {
+    Level lv;
+    lv.A = op(g);
+    if (lv.A.grid().nodes() != g.nodes())
+      throw std::invalid_argument("multigrid: the rediscretised operator does not live on the hierarchy's grid");
+    levels_.push_back(std::move(lv));
   }
   for (size_t l = 0; l + 1 < levels_.size(); ++l) estimate_lmax(levels_[l]);
   factor_coarse();
@@ -162,7 +180,7 @@ void Multigrid::set_bottom_block(const std::vector<real>& B) {
     }
     const GridDims &fg = f.A.grid(), &cg = c.A.grid();
     const index Mf = fg.nx() * fg.ny(), Mc = cg.nx() * cg.ny();
-    const Interp1D &X = f.to_coarse.axis[0], &Y = f.to_coarse.axis[1];
+    const Interp1D &X = grids_->to_coarse[l].axis[0], &Y = grids_->to_coarse[l].axis[1];
     std::vector<real> Bc(4 * Mc, 0.0);
     for (int fld = 0; fld < 4; ++fld)
       for (index jy = 0; jy < cg.ny(); ++jy)
@@ -243,7 +261,7 @@ void Multigrid::vcycle(int l) const {
   {
     const double nf = double(n);
     ScopedTimer t(Kernel::restrict_, nf * in_precision<T>(kRestrictCost));
-    restrict_to_coarse<T>(lv.to_coarse, 3, w.r.data(), c.b.data());
+    restrict_to_coarse<T>(grids_->to_coarse[l], 3, w.r.data(), c.b.data());
     zero_constrained<T>(cg, lv.A.faces(), c.b.data());
   }
   vcycle<T>(l + 1);
@@ -252,7 +270,7 @@ void Multigrid::vcycle(int l) const {
     // interpolated from constrained coarse nodes only), the mask makes it exact
     const double nf = double(n);
     ScopedTimer t(Kernel::prolongate, nf * in_precision<T>(kProlongateCost));
-    prolongate<T>(lv.to_coarse, 3, c.x.data(), w.xp, true);
+    prolongate<T>(grids_->to_coarse[l], 3, c.x.data(), w.xp, true);
     zero_constrained<T>(lv.A.grid(), lv.A.faces(), w.xp);
   }
   smooth<T>(l, false);

@@ -1,7 +1,7 @@
 // Geometric multigrid V-cycle for the Q1 elasticity operator on the brick grid,
 // used as a preconditioner (one V-cycle with zero initial guess per apply).
 //
-// Hierarchy: each coarser grid has ceil(e/2) elements along every axis whose
+// Hierarchy (GridHierarchy, shared): each coarser grid has ceil(e/2) elements along every axis whose
 // spacing is within 1.5x of the finest (semi-coarsening for anisotropic
 // bricks; all axes on the benchmark's near-cubic bricks), non-nested when e is
 // odd, the same box and constrained faces, and is rediscretised (same brick
@@ -33,6 +33,7 @@
 // (2*degree+1) * 306/3 + 20 flops per dof; the hierarchy adds about 1/7.
 #pragma once
 #include <Eigen/SparseCholesky>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -49,18 +50,39 @@ const char* to_string(Precision p);
 struct MGOptions {
   int degree = 3;
   real range = 15;
-  index coarse_nodes = 400;
+  index coarse_nodes = 400;  // used when the hierarchy is built (GridHierarchy::build)
   Precision precision = Precision::single_precision;
 };
 
+// The grids of a multigrid hierarchy and the transfers between them, for one
+// fine grid; built once and shared by every multigrid on that grid (the K_ii
+// solver and the Newton-step preconditioner use the same one).
+struct GridHierarchy {
+  std::vector<GridDims> grids;      // finest first
+  std::vector<Transfer> to_coarse;  // grids[l] -> grids[l + 1]
+  // semi-coarsening until a grid has at most coarse_nodes nodes
+  static std::shared_ptr<const GridHierarchy> build(const GridDims& fine, index coarse_nodes);
+};
+
+// The description of the operator a multigrid preconditions: its
+// rediscretisation on any grid of the hierarchy (the finest included). Other
+// materials or constrained faces plug in here; per-node boundary terms come
+// in through set_bottom_block.
+using Rediscretisation = std::function<ElasticityOperator(const GridDims&)>;
+// isotropic elasticity (E, nu) with the given constrained faces on every grid
+Rediscretisation elasticity_on(unsigned faces, real E, real nu);
+
 class Multigrid : public LinearOperator {
  public:
+  Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt = {});
+  // builds its own hierarchy (opt.coarse_nodes) for elasticity on `fine`
   Multigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt = {});
   index size() const override { return levels_[0].A.size(); }
   void apply(const real* r, real* z) const override;
 
   int num_levels() const { return int(levels_.size()); }
   const MGOptions& options() const { return opt_; }
+  const std::shared_ptr<const GridHierarchy>& hierarchy() const { return grids_; }
   // work of one V-cycle in applications of the finest operator: 2*degree
   // residual applies on every level but the coarsest, weighted by its size
   // (transfers, vector updates and the coarse solve not counted)
@@ -76,7 +98,6 @@ class Multigrid : public LinearOperator {
   struct Level {
     ElasticityOperator A;  // double: lmax estimate, coarse factorisation, op()
     real lmax = 0;
-    Transfer to_coarse;  // to the next level (unused on the coarsest)
   };
   // The V-cycle's data on one level in precision T.
   template <class T>
@@ -105,6 +126,7 @@ class Multigrid : public LinearOperator {
   void estimate_lmax(Level& lv);
 
   MGOptions opt_;
+  std::shared_ptr<const GridHierarchy> grids_;
   std::vector<Level> levels_;
   std::vector<Work<double>> work_d_;
   std::vector<Work<float>> work_s_;
