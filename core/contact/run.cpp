@@ -35,6 +35,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   if (opt.phase_done) opt.phase_done("final check and recovery", t4 - t3);
   R.times = {t1 - t0, t2 - t1, t3 - t2, t4 - t3, t4 - t0};
   R.inner_iterations = cond.iterations + R.newton.inner_iterations + R.report.inner.iterations + rec.iterations;
+  R.fine_matvecs_total = R.newton.fine_matvecs + S.apply_work(cond.iterations) +
+                         S.apply_work(R.report.inner.iterations) + (opt.recover_interior ? S.apply_work(rec.iterations) : 0);
   R.peak_memory = peak_memory_bytes();
   return R;
 }

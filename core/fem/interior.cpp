@@ -17,6 +17,7 @@ InteriorSolution solve_interior_elasticity(const Problem& P, const Multigrid& mg
   CGWorkspace ws;
   s.stats = pcg(mg.op(0), &mg, b.data(), s.u.data(), o, ws);
   s.seconds = wall_time() - t0;
+  s.fine_matvecs = s.stats.operator_applications + s.stats.preconditioner_applications * mg.cycle_work();
   std::vector<real>& r = ws.r;  // reuse as scratch
   mg.op(0).residual(b.data(), s.u.data(), r.data());
   s.relative_residual = s.stats.rhs_norm > 0 ? norm2(n, r.data()) / s.stats.rhs_norm : norm2(n, r.data());
