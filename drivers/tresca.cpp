@@ -194,7 +194,7 @@ int main(int argc, char** argv) {
     if (profile) std::printf("\nkernel profile (%s, %d threads)\n%s", build_info().c_str(), threads,
                              profile_table(R.times.total).c_str());
     try {
-      const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status};
+      const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.phi};
       if (!json_path.empty()) write_file_atomic(json_path, run_summary(spec, R, threads, opt).render() + "\n");
       if (!csv_path.empty()) write_contact_csv(csv_path, *R.problem, cf);
       if (!vtk_path.empty()) {

@@ -29,13 +29,13 @@ inline real node_step(index i, index p, real phi, const real* u, const real* lam
 }
 }  // namespace
 
-real approximation_step(index p, real phi, const real* u, const real* lambda, const real* r, real* v, real* d,
+real approximation_step(index p, const real* phi, const real* u, const real* lambda, const real* r, real* v, real* d,
                         std::uint8_t* status) {
-  TRESCA_ASSERT(p >= 0 && phi >= 0);
+  TRESCA_ASSERT(p >= 0 && (p == 0 || phi != nullptr));
   // per-node work in parallel, then the deterministic blocked sum of v.v.
   // (The test oracle is the dense reference Newton in tests/test_newton.cpp.)
 #pragma omp parallel for schedule(static) if (worth_threads(double(p) * kApproximationStepCost))
-  for (index i = 0; i < p; ++i) node_step(i, p, phi, u, lambda, r, v, d, status);
+  for (index i = 0; i < p; ++i) node_step(i, p, phi[i], u, lambda, r, v, d, status);
   return dot(4 * p, v, v);
 }
 

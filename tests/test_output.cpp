@@ -62,7 +62,9 @@ class OutputFiles : public ::testing::Test {
     delete R_;
     delete spec_;
   }
-  ContactFields fields() const { return {&R_->newton.u, &R_->newton.lambda, &R_->report.r, &R_->report.status}; }
+  ContactFields fields() const {
+    return {&R_->newton.u, &R_->newton.lambda, &R_->report.r, &R_->report.status, &R_->phi};
+  }
   static ProblemSpec* spec_;
   static RunResult* R_;
 };
@@ -84,17 +86,17 @@ TEST_F(OutputFiles, ContactCsvRowsAreTheSolversValues) {
   std::istringstream is(slurp(path));
   std::string line;
   std::getline(is, line);
-  EXPECT_EQ(line, "ix,iy,x,y,ux,uy,uz,lambda,contact,stick");
+  EXPECT_EQ(line, "ix,iy,x,y,ux,uy,uz,lambda,phi,contact,stick");
   const Problem& P = *R_->problem;
   const index p = P.contact_nodes();
   const auto &u = R_->newton.u, &lam = R_->newton.lambda;
   const auto& st = R_->report.status;
   index rows = 0;
   while (std::getline(is, line)) {
-    double v[10];
-    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", v, v + 1, v + 2, v + 3, v + 4, v + 5,
-                          v + 6, v + 7, v + 8, v + 9),
-              10)
+    double v[11];
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", v, v + 1, v + 2, v + 3, v + 4,
+                          v + 5, v + 6, v + 7, v + 8, v + 9, v + 10),
+              11)
         << line;
     const index i = rows++;
     ASSERT_LT(i, p);
@@ -108,8 +110,9 @@ TEST_F(OutputFiles, ContactCsvRowsAreTheSolversValues) {
     EXPECT_EQ(v[5], u[p + i]) << "u_y of node " << i;
     EXPECT_EQ(v[6], u[2 * p + i]) << "u_z of node " << i;
     EXPECT_EQ(v[7], lam[i]);
-    EXPECT_EQ(v[8], (st[i] & kContact) ? 1 : 0);
-    EXPECT_EQ(v[9], (st[i] & kStick) ? 1 : 0);
+    EXPECT_EQ(v[8], R_->phi[i]);
+    EXPECT_EQ(v[9], (st[i] & kContact) ? 1 : 0);
+    EXPECT_EQ(v[10], (st[i] & kStick) ? 1 : 0);
   }
   EXPECT_EQ(rows, p);
 }

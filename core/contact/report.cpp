@@ -8,7 +8,7 @@
 
 namespace tresca {
 
-FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, real phi,
+FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const std::vector<real>& phi,
                          const NewtonResult& R, real tight_rtol) {
   const index p = S.size() / 3;
   FinalReport F;
@@ -17,7 +17,7 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
   F.r.resize(3 * p);
   for (index i = 0; i < 3 * p; ++i) F.r[i] = Su[i] - btilde[i];
   F.status.resize(p);
-  F.true_residual = std::sqrt(approximation_step(p, phi, R.u.data(), R.lambda.data(), F.r.data(), v.data(),
+  F.true_residual = std::sqrt(approximation_step(p, phi.data(), R.u.data(), R.lambda.data(), F.r.data(), v.data(),
                                                  d.data(), F.status.data()));
   F.btilde_norm = norm2(3 * p, btilde.data());
   F.true_residual_relative = F.btilde_norm > 0 ? F.true_residual / F.btilde_norm : F.true_residual;
@@ -31,14 +31,14 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
     F.lambda_violation = std::max(F.lambda_violation, -lam);
     F.complementarity = std::max(F.complementarity, std::abs(lam * uz));
     const real rt = std::hypot(rx, ry), ut = std::hypot(ux, uy);
-    F.friction_bound = std::max(F.friction_bound, rt - phi);
+    F.friction_bound = std::max(F.friction_bound, rt - phi[i]);
     const bool stick = F.status[i] & kStick;
     if (stick) {
       F.stick_slip = std::max(F.stick_slip, ut);
       F.sticking += 1;
     } else {
       F.sliding += 1;
-      if (ut > 0) F.friction_direction = std::max(F.friction_direction, std::hypot(rx + phi * ux / ut, ry + phi * uy / ut));
+      if (ut > 0) F.friction_direction = std::max(F.friction_direction, std::hypot(rx + phi[i] * ux / ut, ry + phi[i] * uy / ut));
     }
     (F.status[i] & kContact ? F.active : F.separated) += 1;
     F.ux_min = std::min(F.ux_min, ux);

@@ -29,7 +29,7 @@ struct FinalReport {
   SolveStats inner;                   // the tight inner solve behind S u
 };
 
-FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, real phi,
+FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const std::vector<real>& phi,
                          const NewtonResult& R, real tight_rtol = 1e-12);
 
 }  // namespace tresca

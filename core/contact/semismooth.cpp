@@ -51,7 +51,7 @@ struct ReducedSystem {
 
 // Fills L from the node status and the approximation step (v, d); returns
 // whether any known increment is nonzero.
-bool linearise(index p, real phi, const std::vector<std::uint8_t>& status, const std::vector<real>& v,
+bool linearise(index p, const std::vector<real>& phi, const std::vector<std::uint8_t>& status, const std::vector<real>& v,
                const std::vector<real>& d, ReducedSystem& L) {
   bool any_known = false;
   for (index i = 0; i < p; ++i) {
@@ -62,7 +62,7 @@ bool linearise(index p, real phi, const std::vector<std::uint8_t>& status, const
     L.free[i] = L.free[p + i] = !stick;
     L.free[2 * p + i] = !contact;
     real h11 = 0, h12 = 0, h22 = 0;
-    if (!stick) sliding_block(phi, d[i], d[p + i], h11, h12, h22);
+    if (!stick) sliding_block(phi[i], d[i], d[p + i], h11, h12, h22);
     L.h[i] = h11;
     L.h[p + i] = h12;
     L.h[2 * p + i] = h22;
@@ -167,7 +167,7 @@ bool stagnated(const std::vector<real>& h, int w) {
   return last > 0.5 * before;
 }
 
-NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, real phi,
+NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, const std::vector<real>& phi,
                                const NewtonOptions& opt) {
   const double t0 = wall_time();
   const index p = S.size() / 3, n3 = 3 * p;
@@ -178,7 +178,11 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   if (index(btilde.size()) != n3) size_error("b~", btilde.size(), n3);
   if (opt.u0 && index(opt.u0->size()) != n3) size_error("u0", opt.u0->size(), n3);
   if (opt.lambda0 && index(opt.lambda0->size()) != p) size_error("lambda0", opt.lambda0->size(), p);
-  if (!(phi >= 0) || !std::isfinite(phi)) throw std::invalid_argument("semismooth_newton: phi must be >= 0 and finite");
+  if (index(phi.size()) != p) size_error("phi", phi.size(), p);
+  for (index i = 0; i < p; ++i)
+    if (!(phi[i] >= 0) || !std::isfinite(phi[i]))
+      throw std::invalid_argument("semismooth_newton: phi of contact node " + std::to_string(i) + " = " +
+                                  std::to_string(phi[i]) + " must be >= 0 and finite");
   InnerWork work;
   NewtonResult R;
   R.u.assign(n3, 0);
@@ -210,7 +214,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     {
       ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
       for (index i = 0; i < n3; ++i) r[i] = R.Su[i] - btilde[i];
-      vnorm = std::sqrt(approximation_step(p, phi, R.u.data(), R.lambda.data(), r.data(), v.data(), d.data(),
+      vnorm = std::sqrt(approximation_step(p, phi.data(), R.u.data(), R.lambda.data(), r.data(), v.data(), d.data(),
                                            R.status.data()));
     }
     R.history.push_back(vnorm);

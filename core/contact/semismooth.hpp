@@ -82,7 +82,8 @@ struct NewtonResult {
 // isolated dip does not move; at the round-off floor the maxima stay flat.
 bool stagnated(const std::vector<real>& h, int w);
 
-NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, real phi,
+// phi: the Tresca bound of every contact node (p values, >= 0)
+NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, const std::vector<real>& phi,
                                const NewtonOptions& opt);
 
 }  // namespace tresca

@@ -36,6 +36,7 @@ struct ContactFields {
   const std::vector<real>* lambda;  // p
   const std::vector<real>* r;       // 3p contact forces (r_τ, r_z)
   const std::vector<std::uint8_t>* status;
+  const std::vector<real>* phi;     // p: Tresca bound per node
 };
 
 void write_contact_csv(const std::string& path, const Problem& P, const ContactFields& c);
