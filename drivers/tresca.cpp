@@ -23,6 +23,7 @@ const char* kHelp =
     "  --level L          mesh level (default 6): ex = ceil(4*2^(L/2)), ey = ez = ceil(2*2^(L/2))\n"
     "  --dims EXxEYxEZ    explicit element counts instead of a level\n"
     "  --phi F            Tresca friction bound per contact node [N] (default 1)\n"
+    "  --gap G            the rigid plane lies G >= 0 metres below the contact face (default 0)\n"
     "  --eps E            stopping tolerance on ||v|| (default 1e-6, absolute)\n"
     "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
     "  --max-newton N     Newton iteration limit (default 50)\n"
@@ -69,7 +70,7 @@ int main(int argc, char** argv) {
   bool quiet = false, profile = false;
   try {
     const Args a(argc, argv,
-                  {"--level", "--dims", "--phi", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
+                  {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
                    "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision"},
                   {"--quiet", "--help", "--profile"});
     if (a.has("--help")) {
@@ -194,7 +195,7 @@ int main(int argc, char** argv) {
     if (profile) std::printf("\nkernel profile (%s, %d threads)\n%s", build_info().c_str(), threads,
                              profile_table(R.times.total).c_str());
     try {
-      const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.phi};
+      const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.contact.phi};
       if (!json_path.empty()) write_file_atomic(json_path, run_summary(spec, R, threads, opt).render() + "\n");
       if (!csv_path.empty()) write_contact_csv(csv_path, *R.problem, cf);
       if (!vtk_path.empty()) {

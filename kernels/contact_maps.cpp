@@ -9,9 +9,10 @@
 namespace tresca {
 
 namespace {
-inline real node_step(index i, index p, real phi, const real* u, const real* lambda, const real* r, real* v,
+inline real node_step(index i, index p, real phi, real gap, const real* u, const real* lambda, const real* r, real* v,
                       real* d, std::uint8_t* status) {
-  const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i], x4 = lambda[i];
+  // x3 enters through F_4 = u_z + g
+  const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + gap, x4 = lambda[i];
   const real z1 = x1 - r[i], z2 = x2 - r[p + i];
   const real nz = std::sqrt(z1 * z1 + z2 * z2);
   const real s = nz > phi ? 1 - phi / nz : 0;
@@ -29,13 +30,13 @@ inline real node_step(index i, index p, real phi, const real* u, const real* lam
 }
 }  // namespace
 
-real approximation_step(index p, const real* phi, const real* u, const real* lambda, const real* r, real* v, real* d,
-                        std::uint8_t* status) {
-  TRESCA_ASSERT(p >= 0 && (p == 0 || phi != nullptr));
+real approximation_step(index p, const ContactLaw& law, const real* u, const real* lambda, const real* r, real* v,
+                        real* d, std::uint8_t* status) {
+  TRESCA_ASSERT(p >= 0 && (p == 0 || (law.phi != nullptr && law.gap != nullptr)));
   // per-node work in parallel, then the deterministic blocked sum of v.v.
   // (The test oracle is the dense reference Newton in tests/test_newton.cpp.)
 #pragma omp parallel for schedule(static) if (worth_threads(double(p) * kApproximationStepCost))
-  for (index i = 0; i < p; ++i) node_step(i, p, phi[i], u, lambda, r, v, d, status);
+  for (index i = 0; i < p; ++i) node_step(i, p, law.phi[i], law.gap[i], u, lambda, r, v, d, status);
   return dot(4 * p, v, v);
 }
 

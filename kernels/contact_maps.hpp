@@ -1,16 +1,17 @@
 // Per-contact-node maps of the semismooth* Newton method (method.md §3–4),
-// with a Tresca bound phi_i per contact node (uniform phi: all equal).
+// with a Tresca bound phi_i and an initial gap g_i >= 0 to the rigid obstacle
+// per contact node (non-penetration u_z + g_i >= 0; the benchmark: g = 0).
 //
 // Unknowns per node i: x = (u_x, u_y, u_z, lambda); r = S u − b̃ (3 blocks of p).
-// F_12 = r_12, F_3 = r_3 − lambda, F_4 = u_z.
+// F_12 = r_12, F_3 = r_3 − lambda, F_4 = u_z + g.
 // Approximation step (closed forms of the paper's problems (i)–(iii)):
 //   z = x_12 − F_12,  d_12 = max(0, 1 − phi/|z|) z,  v_12 = d_12 − x_12
 //   v_3 = −F_3
-//   d_4 = max(0, lambda − u_z),                      v_4 = d_4 − lambda
+//   d_4 = max(0, lambda − (u_z + g)),                v_4 = d_4 − lambda
 // Node status: sticking iff d_12 = 0; in contact iff d_4 > 0.
 // Newton blocks (10): sliding H_1 = phi/|d|^3 [[d2², −d1 d2], [−d1 d2, d1²]].
 //
-// DATA LAYOUT: SoA. u, r: [x | y | z] blocks of p; lambda, phi: p; v: 4 blocks of p
+// DATA LAYOUT: SoA. u, r: [x | y | z] blocks of p; lambda, phi, gap: p; v: 4 blocks of p
 // [v1 | v2 | v3 | v4]; d: 3 blocks [d1 | d2 | d4]; status: p bytes
 // (bit0 contact, bit1 stick). Cost per node: ~30 flops, ~120 bytes.
 #pragma once
@@ -22,10 +23,16 @@ namespace tresca {
 
 enum : std::uint8_t { kContact = 1, kStick = 2 };
 
-constexpr Cost kApproximationStepCost{128, 30};  // per contact node
+constexpr Cost kApproximationStepCost{136, 31};  // per contact node
 
 // Writes v, d, status; returns sum of v^2 (deterministic order).
-real approximation_step(index p, const real* phi, const real* u, const real* lambda, const real* r, real* v, real* d,
+// The contact law of p nodes: Tresca bounds phi (N) and gaps (m), p values each.
+struct ContactLaw {
+  const real* phi;
+  const real* gap;
+};
+
+real approximation_step(index p, const ContactLaw& law, const real* u, const real* lambda, const real* r, real* v, real* d,
                         std::uint8_t* status);
 
 // The 2x2 block H_1 of a sliding node from d_12 (entries h11, h12, h22).

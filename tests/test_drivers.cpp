@@ -78,6 +78,8 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --table 3-1", "3-1");
   expect_error("tresca --level", "--level");
   expect_error("tresca --dims 4x2x2 --outer-pc ilu", "ilu");
+  expect_error("tresca --dims 4x2x2 --gap -0.1", "-0.1");
+  expect_error("tresca --dims 4x2x2 --gap nan", "nan");
 }
 
 TEST(TrescaDriver, ReportsNonConvergenceInOutputAndExitStatus) {

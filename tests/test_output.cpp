@@ -63,7 +63,7 @@ class OutputFiles : public ::testing::Test {
     delete spec_;
   }
   ContactFields fields() const {
-    return {&R_->newton.u, &R_->newton.lambda, &R_->report.r, &R_->report.status, &R_->phi};
+    return {&R_->newton.u, &R_->newton.lambda, &R_->report.r, &R_->report.status, &R_->contact.phi};
   }
   static ProblemSpec* spec_;
   static RunResult* R_;
@@ -110,7 +110,7 @@ TEST_F(OutputFiles, ContactCsvRowsAreTheSolversValues) {
     EXPECT_EQ(v[5], u[p + i]) << "u_y of node " << i;
     EXPECT_EQ(v[6], u[2 * p + i]) << "u_z of node " << i;
     EXPECT_EQ(v[7], lam[i]);
-    EXPECT_EQ(v[8], R_->phi[i]);
+    EXPECT_EQ(v[8], R_->contact.phi[i]);
     EXPECT_EQ(v[9], (st[i] & kContact) ? 1 : 0);
     EXPECT_EQ(v[10], (st[i] & kStick) ? 1 : 0);
   }

@@ -8,16 +8,17 @@
 
 namespace tresca {
 
-FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const std::vector<real>& phi,
+FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
                          const NewtonResult& R, real tight_rtol) {
   const index p = S.size() / 3;
+  const std::vector<real>& phi = law.phi;
   FinalReport F;
   std::vector<real> Su(3 * p), v(4 * p), d(3 * p);
   F.inner = S.apply(R.u.data(), Su.data(), tight_rtol);
   F.r.resize(3 * p);
   for (index i = 0; i < 3 * p; ++i) F.r[i] = Su[i] - btilde[i];
   F.status.resize(p);
-  F.true_residual = std::sqrt(approximation_step(p, phi.data(), R.u.data(), R.lambda.data(), F.r.data(), v.data(),
+  F.true_residual = std::sqrt(approximation_step(p, law.law(), R.u.data(), R.lambda.data(), F.r.data(), v.data(),
                                                  d.data(), F.status.data()));
   F.btilde_norm = norm2(3 * p, btilde.data());
   F.true_residual_relative = F.btilde_norm > 0 ? F.true_residual / F.btilde_norm : F.true_residual;
@@ -27,9 +28,10 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
     const real ux = R.u[i], uy = R.u[p + i], uz = R.u[2 * p + i], lam = R.lambda[i];
     const real rx = F.r[i], ry = F.r[p + i], rz = F.r[2 * p + i];
     F.equilibrium = std::max(F.equilibrium, std::abs(rz - lam));
-    F.uz_violation = std::max(F.uz_violation, -uz);
+    const real gap = law.gap[i];
+    F.uz_violation = std::max(F.uz_violation, -(uz + gap));
     F.lambda_violation = std::max(F.lambda_violation, -lam);
-    F.complementarity = std::max(F.complementarity, std::abs(lam * uz));
+    F.complementarity = std::max(F.complementarity, std::abs(lam * (uz + gap)));
     const real rt = std::hypot(rx, ry), ut = std::hypot(ux, uy);
     F.friction_bound = std::max(F.friction_bound, rt - phi[i]);
     const bool stick = F.status[i] & kStick;

@@ -3,9 +3,9 @@
 // then r = S u − b̃ and
 //   true_residual      ||v̂|| of a fresh approximation step (the stopping quantity)
 //   equilibrium        max_i |r_z − λ|                         [N]
-//   uz_violation       max(0, −min u_z)                        [m]
+//   uz_violation       max(0, −min (u_z + g))  (penetration)   [m]
 //   lambda_violation   max(0, −min λ)                          [N]
-//   complementarity    max_i |λ_i u_z,i|                        [N m]
+//   complementarity    max_i |λ_i (u_z,i + g_i)|                [N m]
 //   friction_bound     max(0, max_i |r_τ| − φ)                 [N]
 //   friction_direction max over sliding nodes |r_τ + φ u_τ/|u_τ||  [N]
 //   stick_slip         max over sticking nodes |u_τ|           [m]
@@ -29,7 +29,7 @@ struct FinalReport {
   SolveStats inner;                   // the tight inner solve behind S u
 };
 
-FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const std::vector<real>& phi,
+FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
                          const NewtonResult& R, real tight_rtol = 1e-12);
 
 }  // namespace tresca

@@ -8,7 +8,9 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   RunResult R;
   const double t0 = wall_time();
   R.problem = std::make_unique<Problem>(make_problem(spec));
-  R.phi = opt.phi.empty() ? std::vector<real>(R.problem->contact_nodes(), spec.phi) : opt.phi;
+  R.contact = opt.contact.phi.empty()
+                  ? ContactConditions::uniform(R.problem->contact_nodes(), spec.phi, spec.gap)
+                  : opt.contact;
   SteklovPoincare S(*R.problem, opt.mg);
   const double t1 = wall_time();
   if (opt.phase_done) opt.phase_done("setup (mesh, operators, multigrid)", t1 - t0);
@@ -24,12 +26,12 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.newton.lambda.assign(p, 0);
     R.newton.status.assign(p, 0);
   } else {
-    R.newton = semismooth_newton(S, btilde, R.phi, opt.newton);
+    R.newton = semismooth_newton(S, btilde, R.contact, opt.newton);
   }
   const double t3 = wall_time();
   R.fine_matvecs_solve = R.newton.fine_matvecs;
   if (opt.phase_done) opt.phase_done("semismooth* Newton", t3 - t2);
-  R.report = final_report(S, btilde, R.phi, R.newton, opt.tight_rtol);
+  R.report = final_report(S, btilde, R.contact, R.newton, opt.tight_rtol);
   SolveStats rec;
   if (opt.recover_interior) rec = S.recover(R.newton.u.data(), opt.tight_rtol, R.u_full);
   const double t4 = wall_time();

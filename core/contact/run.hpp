@@ -19,8 +19,8 @@ struct RunOptions {
   std::function<void(const char* phase, double seconds)> phase_done;
   bool recover_interior = true;  // full 3D displacement (needed for VTK output)
   real tight_rtol = 1e-12;
-  // Tresca bound per contact node (p values); empty: spec.phi at every node
-  std::vector<real> phi;
+  // the contact law per node (p values each); empty: spec.phi and spec.gap at every node
+  ContactConditions contact;
 };
 
 struct RunTimes {
@@ -31,7 +31,7 @@ struct RunResult {
   std::unique_ptr<Problem> problem;
   RunTimes times;
   NewtonResult newton;
-  std::vector<real> phi;  // the Tresca bound used at each contact node
+  ContactConditions contact;  // the law used at each contact node
   FinalReport report;
   std::vector<real> u_full;  // 3N SoA (empty if not recovered)
   long long inner_iterations = 0;  // over the whole run, including condensation and recovery

@@ -167,7 +167,7 @@ bool stagnated(const std::vector<real>& h, int w) {
   return last > 0.5 * before;
 }
 
-NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, const std::vector<real>& phi,
+NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
                                const NewtonOptions& opt) {
   const double t0 = wall_time();
   const index p = S.size() / 3, n3 = 3 * p;
@@ -178,11 +178,17 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   if (index(btilde.size()) != n3) size_error("b~", btilde.size(), n3);
   if (opt.u0 && index(opt.u0->size()) != n3) size_error("u0", opt.u0->size(), n3);
   if (opt.lambda0 && index(opt.lambda0->size()) != p) size_error("lambda0", opt.lambda0->size(), p);
+  const std::vector<real>& phi = law.phi;
   if (index(phi.size()) != p) size_error("phi", phi.size(), p);
-  for (index i = 0; i < p; ++i)
+  if (index(law.gap.size()) != p) size_error("gap", law.gap.size(), p);
+  for (index i = 0; i < p; ++i) {
     if (!(phi[i] >= 0) || !std::isfinite(phi[i]))
       throw std::invalid_argument("semismooth_newton: phi of contact node " + std::to_string(i) + " = " +
                                   std::to_string(phi[i]) + " must be >= 0 and finite");
+    if (!(law.gap[i] >= 0) || !std::isfinite(law.gap[i]))
+      throw std::invalid_argument("semismooth_newton: gap of contact node " + std::to_string(i) + " = " +
+                                  std::to_string(law.gap[i]) + " must be >= 0 and finite");
+  }
   InnerWork work;
   NewtonResult R;
   R.u.assign(n3, 0);
@@ -214,7 +220,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     {
       ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
       for (index i = 0; i < n3; ++i) r[i] = R.Su[i] - btilde[i];
-      vnorm = std::sqrt(approximation_step(p, phi.data(), R.u.data(), R.lambda.data(), r.data(), v.data(), d.data(),
+      vnorm = std::sqrt(approximation_step(p, law.law(), R.u.data(), R.lambda.data(), r.data(), v.data(), d.data(),
                                            R.status.data()));
     }
     R.history.push_back(vnorm);

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "core/contact/steklov.hpp"
+#include "kernels/contact_maps.hpp"
 
 namespace tresca {
 
@@ -82,8 +83,15 @@ struct NewtonResult {
 // isolated dip does not move; at the round-off floor the maxima stay flat.
 bool stagnated(const std::vector<real>& h, int w);
 
-// phi: the Tresca bound of every contact node (p values, >= 0)
-NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, const std::vector<real>& phi,
+// The contact law per contact node: Tresca bound phi_i >= 0 [N] and initial
+// gap g_i >= 0 [m] to the rigid obstacle (non-penetration u_z + g_i >= 0).
+struct ContactConditions {
+  std::vector<real> phi, gap;
+  static ContactConditions uniform(index p, real phi, real gap) { return {std::vector<real>(p, phi), std::vector<real>(p, gap)}; }
+  ContactLaw law() const { return {phi.data(), gap.data()}; }
+};
+
+NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
                                const NewtonOptions& opt);
 
 }  // namespace tresca

@@ -52,6 +52,10 @@ void validate(const ProblemSpec& s) {
     os << "Poisson ratio nu = " << s.nu << " must lie in (-1, 0.5)";
     fail(os.str());
   }
+  if (!(s.gap >= 0) || !std::isfinite(s.gap)) {
+    os << "gap = " << s.gap << " must be >= 0 and finite";
+    fail(os.str());
+  }
   if (!(s.phi >= 0) || !std::isfinite(s.phi)) {
     os << "friction bound phi = " << s.phi << " must be >= 0 and finite";
     fail(os.str());

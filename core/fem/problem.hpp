@@ -30,6 +30,7 @@ struct ProblemSpec {
   std::array<real, 3> traction_right{-5e8, 0, 0};  // on x = x0 + lx
   std::array<real, 3> traction_top{0, 0, -1e8};    // on z = z0 + lz
   real phi = 1;                    // Tresca bound per contact node (a force)
+  real gap = 0;                    // initial gap to the rigid plane below the contact face [m]
 
   // sizes follow from the element counts alone (no need to build the problem)
   index nodes() const { return (ex + 1) * (ey + 1) * (ez + 1); }

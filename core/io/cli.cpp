@@ -85,6 +85,7 @@ ProblemSpec spec_from_args(const Args& a, int default_level) {
   s.E = a.real_value("--E", s.E);
   s.nu = a.real_value("--nu", s.nu);
   s.phi = a.real_value("--phi", s.phi);
+  s.gap = a.real_value("--gap", s.gap);
   validate(s);
   check_memory(s);
   return s;

@@ -33,7 +33,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
     j.null("level");
   j.raw("dims", "[" + std::to_string(spec.ex) + ", " + std::to_string(spec.ey) + ", " + std::to_string(spec.ez) + "]")
       .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
-      .num("phi", spec.phi).num("eps", eps).integer("threads", threads).str("build", build_info())
+      .num("phi", spec.phi).num("gap", spec.gap).num("eps", eps).integer("threads", threads).str("build", build_info())
       .str("mg_precision", to_string(opt.mg.precision)).integer("newton_iterations", N.iterations)
       .boolean("converged", N.converged()).str("reason", to_string(N.reason))
       .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())
