@@ -289,7 +289,7 @@ void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, in
 void elasticity_diagonal(const ElasticityStencil& k, real* d) {
   const GridDims& g = k.g;
   const index N = g.nodes();
-#pragma omp parallel for collapse(2) schedule(static) if (worth_threads(double(N) * Cost{24, 0}))
+#pragma omp parallel for collapse(2) schedule(static) if (worth_threads(double(N) * kDiagonalCost))
   for (index iz = 0; iz < g.nz(); ++iz)
     for (index iy = 0; iy < g.ny(); ++iy)
       for (index ix = 0; ix < g.nx(); ++ix) {

@@ -89,7 +89,8 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_
 void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
                           const real* b = nullptr);
 
-// d = diag(K) (1 on constrained dofs).
+// d = diag(K) (1 on constrained dofs). Per node: writes 3 values.
+constexpr Cost kDiagonalCost{24, 0};
 void elasticity_diagonal(const ElasticityStencil& k, real* d);
 void elasticity_diagonal_ref(const ElasticityStencil& k, real* d);
 

@@ -29,7 +29,6 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.newton = semismooth_newton(S, btilde, R.contact, opt.newton);
   }
   const double t3 = wall_time();
-  R.fine_matvecs_solve = R.newton.fine_matvecs;
   if (opt.phase_done) opt.phase_done("semismooth* Newton", t3 - t2);
   R.report = final_report(S, btilde, R.contact, R.newton, opt.tight_rtol);
   SolveStats rec;

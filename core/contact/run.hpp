@@ -35,14 +35,13 @@ struct RunResult {
   FinalReport report;
   std::vector<real> u_full;  // 3N SoA (empty if not recovered)
   long long inner_iterations = 0;  // over the whole run, including condensation and recovery
-  // work of the Newton phase in fine-grid matvec equivalents: all applies of
-  // K on every multigrid level, weighted by their size relative to the fine grid
-  double fine_matvecs_solve = 0;
-  // the whole run: condensed load, Newton, the final tight check and the recovery
+  // work in fine-grid matvec equivalents (the Newton phase alone is
+  // newton.fine_matvecs): the whole run, condensed load, Newton, the final
+  // tight check and the recovery
   double fine_matvecs_total = 0;
   double peak_memory = 0;  // bytes, process peak resident set after the run
   double fine_matvecs_per_newton_step() const {
-    return newton.iterations > 0 ? fine_matvecs_solve / newton.iterations : 0;
+    return newton.iterations > 0 ? newton.fine_matvecs / newton.iterations : 0;
   }
 };
 

@@ -20,7 +20,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
       .integer("newton_inner_iterations", N.inner_iterations)
       .integer("outer_limit_hits", N.outer_limit_hits)
       .num("fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step())
-      .num("fine_matvecs_solve", R.fine_matvecs_solve).num("fine_matvecs_total", R.fine_matvecs_total);
+      .num("fine_matvecs_solve", R.newton.fine_matvecs).num("fine_matvecs_total", R.fine_matvecs_total);
   contact.integer("active", F.active).integer("separated", F.separated).integer("sticking", F.sticking)
       .integer("sliding", F.sliding).num("ux_min", F.ux_min).num("uz_max", F.uz_max).num("lambda_sum", F.lambda_sum);
   kkt.num("equilibrium", F.equilibrium).num("uz_violation", F.uz_violation).num("lambda_violation", F.lambda_violation)
