@@ -178,11 +178,7 @@ int main(int argc, char** argv) {
     std::printf("# level %lld: mesh %s, %lld dofs\n", level, dims_string(spec).c_str(), (long long)n);
     std::printf("%-20s %10s %11s %8s %8s %9s %8s %9s\n", "kernel", "time [ms]", "M items/s", "GB/s", "of BW",
                 "GFLOP/s", "of peak", "of bound");
-    std::string out = "{\"build\": \"" + build_info() + "\", \"threads\": " + std::to_string(threads) +
-                      ", \"level\": " + std::to_string(level) + ", \"triad_stream_bytes_per_s\": " + std::to_string(stream) +
-                      ", \"bandwidth_bytes_per_s\": " + std::to_string(bw) +
-                      ", \"peak_flops_per_s\": " + std::to_string(peak) +
-                      ", \"peak_flops_per_s_single\": " + std::to_string(peak_single) + ", \"kernels\": [";
+    std::string kernels;
     for (size_t i = 0; i < rows.size(); ++i) {
       const Row& r = rows[i];
       const double gbs = r.cost.bytes / r.seconds, gfs = r.cost.flops / r.seconds;
@@ -199,10 +195,13 @@ int main(int argc, char** argv) {
       j.str("kernel", r.name).num("seconds", r.seconds).num("items_per_s", r.items / r.seconds)
           .num("bytes_per_s", gbs).num("flops_per_s", gfs).num("fraction_of_bandwidth", gbs / bw)
           .num("fraction_of_peak", gfs / pk).num("fraction_of_bound", bound / r.seconds);
-      out += (i ? ",\n  " : "\n  ") + j.render();
+      kernels += (i ? ",\n  " : "\n  ") + j.render();
     }
-    out += "]}\n";
-    if (!json.empty()) write_file_atomic(json, out);
+    Json out;
+    out.str("build", build_info()).integer("threads", threads).integer("level", level)
+        .num("triad_stream_bytes_per_s", stream).num("bandwidth_bytes_per_s", bw).num("peak_flops_per_s", peak)
+        .num("peak_flops_per_s_single", peak_single).raw("kernels", "[" + kernels + "]");
+    if (!json.empty()) write_file_atomic(json, out.render() + "\n");
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "roofline: error: %s\n", e.what());

@@ -35,12 +35,6 @@ void profile_add(Kernel k, double seconds, double bytes, double flops) {
   e.flops += flops;
 }
 
-ProfileEntry profile_get(Kernel k) { return g_entries[int(k)]; }
-
-void profile_reset() {
-  for (auto& e : g_entries) e = ProfileEntry{};
-}
-
 std::string profile_table(double total) {
   std::string out;
   char line[256];

@@ -20,8 +20,6 @@ struct ProfileEntry {
 };
 
 void profile_add(Kernel k, double seconds, double bytes, double flops);
-ProfileEntry profile_get(Kernel k);
-void profile_reset();
 // Table with calls, time, share of `total_seconds`, GB/s and GFLOP/s.
 std::string profile_table(double total_seconds);
 
