@@ -1,6 +1,7 @@
 // tresca: 3D linear-elastic contact with Tresca friction by the semismooth*
 // Newton method, matrix-free on the contact boundary. See --help.
 // Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure.
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -27,6 +28,9 @@ const char* kHelp =
     "  --eps E            stopping tolerance on ||v|| (default 1e-6, absolute)\n"
     "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
     "  --max-newton N     Newton iteration limit (default 50)\n"
+    "  --scaling paper|diagonal  metric of the approximation step: the paper's (forces and\n"
+    "                     displacements added as numbers; needs near-exact steps) or the\n"
+    "                     diagonal of K_cc per node (default; with --table: paper)\n"
     "  --outer-pc mg|none preconditioner of the boundary Newton system (default mg)\n"
     "  --mg-precision single|double  arithmetic of the multigrid V-cycles (default single;\n"
     "                     the Krylov solvers and all results are double either way)\n"
@@ -71,7 +75,7 @@ int main(int argc, char** argv) {
   try {
     const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision"},
+                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling"},
                   {"--quiet", "--help", "--profile"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
@@ -90,6 +94,13 @@ int main(int argc, char** argv) {
     const std::string pc = a.str("--outer-pc", "mg");
     if (pc != "mg" && pc != "none") throw std::invalid_argument("--outer-pc '" + pc + "' must be mg or none");
     opt.newton.outer_pc = pc == "mg" ? OuterPreconditioner::multigrid : OuterPreconditioner::none;
+    const std::string sc = a.str("--scaling", table.empty() ? "diagonal" : "paper");
+    if (sc != "paper" && sc != "diagonal") throw std::invalid_argument("--scaling '" + sc + "' must be paper or diagonal");
+    if (sc == "paper") {
+      const NewtonOptions paper = NewtonOptions::paper_method();
+      opt.newton.scaling = paper.scaling;
+      opt.newton.forcing_max = paper.forcing_max;
+    }
     const std::string prec = a.str("--mg-precision", "single");
     if (prec != "single" && prec != "double")
       throw std::invalid_argument("--mg-precision '" + prec + "' must be single or double");

@@ -9,34 +9,40 @@
 namespace tresca {
 
 namespace {
-inline real node_step(index i, index p, real phi, real gap, const real* u, const real* lambda, const real* r, real* v,
-                      real* d, std::uint8_t* status) {
-  // x3 enters through F_4 = u_z + g
-  const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + gap, x4 = lambda[i];
-  const real z1 = x1 - r[i], z2 = x2 - r[p + i];
+// d_12, d_4 of the approximation step at scale s (contact_maps.hpp)
+struct NodeStep {
+  real d1, d2, d4;
+  bool stick;
+};
+inline NodeStep node_step(real s, real phi, real x1, real x2, real x3, real x4, real r1, real r2) {
+  const real z1 = x1 - r1 / s, z2 = x2 - r2 / s;
   const real nz = std::sqrt(z1 * z1 + z2 * z2);
-  const real s = nz > phi ? 1 - phi / nz : 0;
-  const real d1 = s * z1, d2 = s * z2, d4 = std::max(real(0), x4 - x3);
-  const real v1 = d1 - x1, v2 = d2 - x2, v3 = -(r[2 * p + i] - x4), v4 = d4 - x4;
-  v[i] = v1;
-  v[p + i] = v2;
-  v[2 * p + i] = v3;
-  v[3 * p + i] = v4;
-  d[i] = d1;
-  d[p + i] = d2;
-  d[2 * p + i] = d4;
-  status[i] = std::uint8_t((d4 > 0 ? kContact : 0) | (s == 0 ? kStick : 0));
-  return v1 * v1 + v2 * v2 + v3 * v3 + v4 * v4;
+  const real t = s * nz > phi ? 1 - phi / (s * nz) : 0;
+  return {t * z1, t * z2, std::max(real(0), x4 - s * x3), t == 0};
 }
 }  // namespace
 
-real approximation_step(index p, const ContactLaw& law, const real* u, const real* lambda, const real* r, real* v,
-                        real* d, std::uint8_t* status) {
+real approximation_step(index p, const ContactLaw& law, const real* scale, const real* u, const real* lambda,
+                        const real* r, real* v, real* d, std::uint8_t* status) {
   TRESCA_ASSERT(p >= 0 && (p == 0 || (law.phi != nullptr && law.gap != nullptr)));
   // per-node work in parallel, then the deterministic blocked sum of v.v.
   // (The test oracle is the dense reference Newton in tests/test_newton.cpp.)
 #pragma omp parallel for schedule(static) if (worth_threads(double(p) * kApproximationStepCost))
-  for (index i = 0; i < p; ++i) node_step(i, p, law.phi[i], law.gap[i], u, lambda, r, v, d, status);
+  for (index i = 0; i < p; ++i) {
+    // x3 enters through F_4 = u_z + g
+    const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + law.gap[i], x4 = lambda[i];
+    const real r1 = r[i], r2 = r[p + i];
+    const NodeStep paper = node_step(1, law.phi[i], x1, x2, x3, x4, r1, r2);
+    v[i] = paper.d1 - x1;
+    v[p + i] = paper.d2 - x2;
+    v[2 * p + i] = -(r[2 * p + i] - x4);
+    v[3 * p + i] = paper.d4 - x4;
+    const NodeStep step = scale ? node_step(scale[i], law.phi[i], x1, x2, x3, x4, r1, r2) : paper;
+    d[i] = step.d1;
+    d[p + i] = step.d2;
+    d[2 * p + i] = step.d4;
+    status[i] = std::uint8_t((step.d4 > 0 ? kContact : 0) | (step.stick ? kStick : 0));
+  }
   return dot(4 * p, v, v);
 }
 

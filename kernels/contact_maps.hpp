@@ -4,16 +4,22 @@
 //
 // Unknowns per node i: x = (u_x, u_y, u_z, lambda); r = S u − b̃ (3 blocks of p).
 // F_12 = r_12, F_3 = r_3 − lambda, F_4 = u_z + g.
-// Approximation step (closed forms of the paper's problems (i)–(iii)):
-//   z = x_12 − F_12,  d_12 = max(0, 1 − phi/|z|) z,  v_12 = d_12 − x_12
+// Approximation step in the metric of a stiffness s_i > 0 [N/m] per node
+// (the paper's problems (i)–(iii) with ½|v|² replaced by ½|v|²·s for the
+// displacement unknowns and ½v²/s for lambda; s = 1 is the paper's step):
+//   z = x_12 − F_12/s,  d_12 = max(0, 1 − phi/(s|z|)) z,  v_12 = d_12 − x_12
 //   v_3 = −F_3
-//   d_4 = max(0, lambda − (u_z + g)),                v_4 = d_4 − lambda
+//   d_4 = max(0, lambda − s (u_z + g)),                   v_4 = d_4 − lambda
+// The paper's step (s = 1) adds forces [N] to displacements [m]: with nodal
+// forces of 1e7 N a force residual of 1 N outweighs any displacement. With
+// s = diag(S) the comparison is in consistent units (issue 9, item 4). Both
+// have the same fixed points: d = x iff x solves the problem.
 // Node status: sticking iff d_12 = 0; in contact iff d_4 > 0.
 // Newton blocks (10): sliding H_1 = phi/|d|^3 [[d2², −d1 d2], [−d1 d2, d1²]].
 //
-// DATA LAYOUT: SoA. u, r: [x | y | z] blocks of p; lambda, phi, gap: p; v: 4 blocks of p
-// [v1 | v2 | v3 | v4]; d: 3 blocks [d1 | d2 | d4]; status: p bytes
-// (bit0 contact, bit1 stick). Cost per node: ~30 flops, ~120 bytes.
+// DATA LAYOUT: SoA. u, r: [x | y | z] blocks of p; lambda, phi, gap, scale: p;
+// v: 4 blocks of p [v1 | v2 | v3 | v4]; d: 3 blocks [d1 | d2 | d4]; status:
+// p bytes (bit0 contact, bit1 stick).
 #pragma once
 #include <cstdint>
 
@@ -23,17 +29,19 @@ namespace tresca {
 
 enum : std::uint8_t { kContact = 1, kStick = 2 };
 
-constexpr Cost kApproximationStepCost{136, 31};  // per contact node
+constexpr Cost kApproximationStepCost{144, 52};  // per contact node, scaled step and paper's v̂
 
-// Writes v, d, status; returns sum of v^2 (deterministic order).
 // The contact law of p nodes: Tresca bounds phi (N) and gaps (m), p values each.
 struct ContactLaw {
   const real* phi;
   const real* gap;
 };
 
-real approximation_step(index p, const ContactLaw& law, const real* u, const real* lambda, const real* r, real* v, real* d,
-                        std::uint8_t* status);
+// v: the paper's v̂ (s = 1), whose norm is the stopping rule (11) whatever
+// the scaling; d and status: the step at scale s (nullptr: s = 1, and then
+// d_12 = x_12 + v_12, d_4 = lambda + v_4). Returns |v̂|^2 (deterministic order).
+real approximation_step(index p, const ContactLaw& law, const real* scale, const real* u, const real* lambda,
+                        const real* r, real* v, real* d, std::uint8_t* status);
 
 // The 2x2 block H_1 of a sliding node from d_12 (entries h11, h12, h22).
 inline void sliding_block(real phi, real d1, real d2, real& h11, real& h12, real& h22) {

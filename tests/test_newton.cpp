@@ -4,6 +4,7 @@
 // by LU, no reduction. Plus the KKT conditions, thread independence and the
 // paper's Table 1 mesh sizes.
 #include <gtest/gtest.h>
+#include <cstdio>
 #include <omp.h>
 
 #include <Eigen/Dense>
@@ -27,9 +28,14 @@ struct DenseNewton {
 };
 
 // Dense semismooth* Newton (paper Section 4) in node-major ordering x^i = (u_τ, u_ν, λ).
-// gap g: non-penetration u_z + g >= 0, i.e. F_4 = u_z + g
+// gap g: non-penetration u_z + g >= 0, i.e. F_4 = u_z + g.
+// scale (empty: the paper's step): the approximation step in the metric
+// W = diag(1/s, 1/s, 1, s) per node, i.e. problems (i)–(iii) minimise
+// ½ vᵀW⁻¹v + ⟨F, v⟩ (+ φ|x_12 + v|); then ŷ = −W⁻¹v̂ and the Newton step is
+// (G A + H) Δ = (G W⁻¹ + H) v̂ (with W = I the paper's (G + H) v̂). The
+// stopping rule is the paper's |v̂| (W = I) either way.
 DenseNewton dense_newton(const Eigen::MatrixXd& S, const Eigen::VectorXd& bt, const std::vector<real>& phis, real gap,
-                         real eps, int maxit) {
+                         const std::vector<real>& scale, real eps, int maxit) {
   const index p = S.rows() / 3, n = 4 * p;
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
@@ -42,29 +48,39 @@ DenseNewton dense_newton(const Eigen::MatrixXd& S, const Eigen::VectorXd& bt, co
     b[4 * i + 3] = -gap;
     for (int a = 0; a < 3; ++a) b[4 * i + a] = bt[a * p + i];
   }
+  // problems (i)–(iii) at node i in the metric with stiffness s: v (4) of x
+  auto approximation = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& F, index i, real s, real* v) {
+    const real phi = phis[i];
+    const Eigen::Vector2d x12(x[4 * i], x[4 * i + 1]);
+    // (i) min (s/2)|v|² + <F_12, v> + phi |x_12 + v|: prox of (phi/s)|.| at x_12 − F_12/s
+    const Eigen::Vector2d z = x12 - Eigen::Vector2d(F[4 * i], F[4 * i + 1]) / s;
+    const Eigen::Vector2d d12 =
+        z.norm() > phi / s ? Eigen::Vector2d((1 - phi / (s * z.norm())) * z) : Eigen::Vector2d::Zero();
+    v[0] = d12[0] - x12[0];
+    v[1] = d12[1] - x12[1];
+    // (ii) min ½v² + F_3 v
+    v[2] = -F[4 * i + 2];
+    // (iii) min v²/(2s) + F_4 v  over x_4 + v >= 0
+    v[3] = std::max(-s * F[4 * i + 3], -x[4 * i + 3]);
+  };
   DenseNewton R;
   R.x = Eigen::VectorXd::Zero(n);
   for (int k = 0; k <= maxit; ++k) {
     const Eigen::VectorXd F = A * R.x - b;
-    Eigen::VectorXd v(n), d(n);
+    Eigen::VectorXd vhat(n), v(n), Winv = Eigen::VectorXd::Ones(n);
     Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n), H = Eigen::MatrixXd::Zero(n, n);
     for (index i = 0; i < p; ++i) {
-      const real phi = phis[i];
-      const Eigen::Vector2d x12(R.x[4 * i], R.x[4 * i + 1]);
-      // (i) min ½|v|² + <F_12, v> + phi |x_12 + v|: prox of phi|.| at x_12 − F_12
-      const Eigen::Vector2d z = x12 - Eigen::Vector2d(F[4 * i], F[4 * i + 1]);
-      const Eigen::Vector2d d12 = z.norm() > phi ? Eigen::Vector2d((1 - phi / z.norm()) * z) : Eigen::Vector2d::Zero();
-      v.segment<2>(4 * i) = d12 - x12;
-      // (ii) min ½v² + F_3 v
-      v[4 * i + 2] = -F[4 * i + 2];
-      // (iii) min ½v² + F_4 v  over x_4 + v >= 0
-      v[4 * i + 3] = std::max(-F[4 * i + 3], -R.x[4 * i + 3]);
+      const real s = scale.empty() ? 1 : scale[i];
+      approximation(R.x, F, i, 1, &vhat[4 * i]);
+      approximation(R.x, F, i, s, &v[4 * i]);
+      Winv.segment<4>(4 * i) << s, s, 1, 1 / s;
+      const Eigen::Vector2d d12 = R.x.segment<2>(4 * i) + v.segment<2>(4 * i);
       const real d4 = R.x[4 * i + 3] + v[4 * i + 3];
       if (d12.norm() == 0) {
         H.block<2, 2>(4 * i, 4 * i).setIdentity();
       } else {
         G.block<2, 2>(4 * i, 4 * i).setIdentity();
-        const real c = phi / std::pow(d12.norm(), 3);
+        const real c = phis[i] / std::pow(d12.norm(), 3);
         H(4 * i, 4 * i) = c * d12[1] * d12[1];
         H(4 * i, 4 * i + 1) = H(4 * i + 1, 4 * i) = -c * d12[0] * d12[1];
         H(4 * i + 1, 4 * i + 1) = c * d12[0] * d12[0];
@@ -75,10 +91,10 @@ DenseNewton dense_newton(const Eigen::MatrixXd& S, const Eigen::VectorXd& bt, co
       else
         H(4 * i + 3, 4 * i + 3) = 1;
     }
-    R.history.push_back(v.norm());
+    R.history.push_back(vhat.norm());
     R.iterates.push_back(R.x);
-    if (v.norm() <= eps || k == maxit) break;
-    const Eigen::VectorXd delta = (G * A + H).partialPivLu().solve((G + H) * v);
+    if (vhat.norm() <= eps || k == maxit) break;
+    const Eigen::VectorXd delta = (G * A + H).partialPivLu().solve((G * Winv.asDiagonal() + H) * v);
     R.x += delta;
     R.iterations = k + 1;
   }
@@ -106,9 +122,11 @@ std::pair<real, real> iterate_errors(const std::vector<real>& u, const std::vect
 // one matrix-free step gives x_{k+1}; (b) the final solutions agree; (c) KKT.
 // phi_of(i): the Tresca bound of contact node i
 template <class PhiOf>
-void compare_with_dense(index ex, index ey, index ez, PhiOf phi_of, bool expect_mixed, bool same_path, real gap = 0) {
+void compare_with_dense(const NewtonOptions& method, index ex, index ey, index ez, PhiOf phi_of, bool expect_mixed,
+                        bool same_path, real gap = 0) {
   ProblemSpec spec = spec_for_dims(ex, ey, ez);
   RunOptions o;
+  o.newton = method;
   o.recover_interior = false;
   o.contact = ContactConditions::uniform(spec.contact_nodes(), 0, gap);
   for (index i = 0; i < spec.contact_nodes(); ++i) o.contact.phi[i] = phi_of(i);
@@ -117,12 +135,19 @@ void compare_with_dense(index ex, index ey, index ez, PhiOf phi_of, bool expect_
   EXPECT_TRUE(R.contact.phi == phi);
   ASSERT_TRUE(R.newton.converged()) << to_string(R.newton.reason);
   const DenseSchur D = dense_schur(*R.problem);
-  const DenseNewton ref = dense_newton(D.S, D.b, phi, gap, 1e-6, 60);
+  SteklovPoincare S(*R.problem);
+  const std::vector<real> scale = method.scaling == StepScaling::diagonal ? step_scale(S) : std::vector<real>{};
+  const DenseNewton ref = dense_newton(D.S, D.b, phi, gap, scale, 1e-6, 60);
   ASSERT_LE(ref.history.back(), 1e-6) << "dense reference did not converge";
   const index p = R.problem->contact_nodes();
+  std::printf("dense  |v|:");
+  for (real h : ref.history) std::printf(" %.3e", h);
+  std::printf("\nmatrix-free |v|:");
+  for (real h : R.newton.history) std::printf(" %.3e", h);
+  std::printf("\n");
 
-  // (a) the Newton map, step by step from the reference iterates
-  SteklovPoincare S(*R.problem);
+  // (a) the Newton map, step by step from the reference iterates, with
+  // near-exact steps (the default forcing makes early steps inexact on purpose)
   const std::vector<real> bt(D.b.data(), D.b.data() + 3 * p);
   for (int k = 0; k + 1 < int(ref.iterates.size()); ++k) {
     std::vector<real> u0(3 * p), l0(p);
@@ -130,7 +155,8 @@ void compare_with_dense(index ex, index ey, index ez, PhiOf phi_of, bool expect_
       for (int a = 0; a < 3; ++a) u0[a * p + i] = ref.iterates[k][4 * i + a];
       l0[i] = ref.iterates[k][4 * i + 3];
     }
-    NewtonOptions no;
+    NewtonOptions no = method;
+    no.forcing_max = 1e-10;
     no.max_iterations = 1;
     no.u0 = &u0;
     no.lambda0 = &l0;
@@ -146,13 +172,26 @@ void compare_with_dense(index ex, index ey, index ez, PhiOf phi_of, bool expect_
     EXPECT_LE(e.first, 2e-8 * umax) << "u after step " << k + 1;
     EXPECT_LE(e.second, 2e-8 * lmax) << "lambda after step " << k + 1;
   }
-  // (b) whole runs: same path where no node decision is marginal, same solution always
+  // (b) whole runs: the same number of Newton steps as the exact-step method
+  // where no node decision is marginal; with near-exact steps the same |v̂|
+  // too; with the default forcing, a superlinear end: the last ratio
+  // |v̂_k+1|/|v̂_k| above the floor of the step accuracy (0.1 eps) is < 1e-3
+  // (a fixed step accuracy gave 1e-2 to 1e-3 per step, and rises)
   if (same_path) {
     EXPECT_EQ(R.newton.iterations, ref.iterations);
-    for (size_t k = 0; k < std::min(R.newton.history.size(), ref.history.size()); ++k)
-      if (ref.history[k] > 1e-6 * ref.history[0]) {
-        EXPECT_NEAR(R.newton.history[k], ref.history[k], 1e-6 * ref.history[k]) << "k=" << k;
-      }
+    if (method.forcing_max <= 1e-8) {
+      for (size_t k = 0; k < std::min(R.newton.history.size(), ref.history.size()); ++k)
+        if (ref.history[k] > 1e-6 * ref.history[0]) {
+          EXPECT_NEAR(R.newton.history[k], ref.history[k], 1e-6 * ref.history[k]) << "k=" << k;
+        }
+    } else {
+      const std::vector<real>& h = R.newton.history;
+      real last = -1;
+      for (size_t k = 0; k + 1 < h.size(); ++k)
+        if (h[k + 1] > 10 * method.eps) last = h[k + 1] / h[k];
+      EXPECT_GT(last, 0) << "no step above the floor";
+      EXPECT_LT(last, 1e-3);
+    }
   }
   real umax, lmax;
   const auto e = iterate_errors(R.newton.u, R.newton.lambda, ref.x, umax, lmax);
@@ -201,29 +240,63 @@ void compare_with_dense(index ex, index ey, index ez, PhiOf phi_of, bool expect_
 
 real uniform(real phi, index) { return phi; }
 
+// The paper's unscaled step with near-exact Newton steps
+TEST(PaperStep, MatchesDenseReferenceAtPaperFriction) {
+  compare_with_dense(NewtonOptions::paper_method(), 8, 4, 4, [](index i) { return uniform(1.0, i); }, false, true);
+}
+
+TEST(PaperStep, MatchesDenseReferenceWithStickSlipAndSeparation) {
+  compare_with_dense(NewtonOptions::paper_method(), 8, 4, 4, [](index i) { return uniform(1e7, i); }, true, false);
+}
+
+// The default: approximation step scaled by diag(K_cc), inexact Newton steps
+// with forcing terms; same iteration counts as the dense exact-step method
 TEST(SemismoothNewton, MatchesDenseReferenceAtPaperFriction) {
-  compare_with_dense(8, 4, 4, [](index i) { return uniform(1.0, i); }, false, true);
+  compare_with_dense({}, 8, 4, 4, [](index i) { return uniform(1.0, i); }, false, true);
 }
 
 TEST(SemismoothNewton, MatchesDenseReferenceWithStickSlipAndSeparation) {
-  compare_with_dense(8, 4, 4, [](index i) { return uniform(1e7, i); }, true, false);
+  compare_with_dense({}, 8, 4, 4, [](index i) { return uniform(1e7, i); }, true, true);
 }
 
 TEST(SemismoothNewton, MatchesDenseReferenceOnOddMesh) {
-  compare_with_dense(7, 3, 3, [](index i) { return uniform(3e6, i); }, false, false);
+  compare_with_dense({}, 7, 3, 3, [](index i) { return uniform(3e6, i); }, false, true);
 }
 
 TEST(SemismoothNewton, MatchesDenseReferenceWithABoundPerNode) {
   // Tresca with phi_i per contact node (issue 10): bounds from 0 to 3e7 N in
   // a pattern that makes neighbours stick and slide
-  compare_with_dense(8, 4, 4, [](index i) { return real((i * 7) % 5) * 7.5e6; }, true, false);
+  compare_with_dense({}, 8, 4, 4, [](index i) { return real((i * 7) % 5) * 7.5e6; }, true, true);
 }
 
 TEST(SemismoothNewton, MatchesDenseReferenceWithAGap) {
   // the rigid plane 5 cm below the contact face: u_z >= -0.05 m; nodes stick,
-  // slide and separate (at phi = 3e6 with a gap, two intermediate lambda steps
-  // exceed the 2e-8 inexact-step bound by 1.3x: issue 9, forcing terms)
-  compare_with_dense(8, 4, 4, [](index i) { return uniform(1e7, i); }, true, false, 0.05);
+  // slide and separate
+  compare_with_dense({}, 8, 4, 4, [](index i) { return uniform(1e7, i); }, true, true, 0.05);
+}
+
+TEST(SemismoothNewton, MatchesDenseReferenceWhereThePaperStepLosesThePath) {
+  // 12x6x6, phi = 1e6: the paper's exact-step method takes 7 steps; its
+  // inexact matrix-free twin parted from it at step 4 and took 9 (issue 9)
+  compare_with_dense({}, 12, 6, 6, [](index i) { return uniform(1e6, i); }, false, true);
+}
+
+TEST(SemismoothNewton, ConvergesSuperlinearly) {
+  // the ratios |v̂_k+1|/|v̂_k| fall step by step to the end (measured: 0.61,
+  // 0.032, 1.4e-4, 1.7e-7); every |v̂| here is above the floor 0.1 eps
+  ProblemSpec spec = spec_for_dims(12, 6, 6);
+  spec.phi = 1e6;
+  RunOptions o;
+  o.recover_interior = false;
+  const RunResult R = run_tresca(spec, o);
+  ASSERT_TRUE(R.newton.converged());
+  const std::vector<real>& h = R.newton.history;
+  ASSERT_GE(h.size(), 5u);
+  std::vector<real> q;
+  for (size_t k = 0; k + 1 < h.size() && h[k + 1] > 10 * o.newton.eps; ++k) q.push_back(h[k + 1] / h[k]);
+  ASSERT_GE(q.size(), 3u);
+  for (size_t k = 1; k < q.size(); ++k) EXPECT_LT(q[k], 0.1 * q[k - 1]) << "ratio " << k;
+  EXPECT_LT(q.back(), 1e-5);
 }
 
 TEST(SemismoothNewton, GapLargerThanTheFreeDisplacementGivesTheFreeElasticSolution) {

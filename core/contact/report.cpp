@@ -18,7 +18,7 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
   F.r.resize(3 * p);
   for (index i = 0; i < 3 * p; ++i) F.r[i] = Su[i] - btilde[i];
   F.status.resize(p);
-  F.true_residual = std::sqrt(approximation_step(p, law.law(), R.u.data(), R.lambda.data(), F.r.data(), v.data(),
+  F.true_residual = std::sqrt(approximation_step(p, law.law(), nullptr, R.u.data(), R.lambda.data(), F.r.data(), v.data(),
                                                  d.data(), F.status.data()));
   F.btilde_norm = norm2(3 * p, btilde.data());
   F.true_residual_relative = F.btilde_norm > 0 ? F.true_residual / F.btilde_norm : F.true_residual;

@@ -42,35 +42,44 @@ struct InnerWork {
 
 // The reduced Newton system of one step (method.md §4).
 struct ReducedSystem {
-  explicit ReducedSystem(index n3) : known(n3), h(n3), rhs(n3), fixed(n3), free(n3) {}
-  std::vector<real> known;  // known increments: Δu_τ = v_12 (sticking), Δu_z = v_4 (contact)
+  explicit ReducedSystem(index n3) : known(n3), h(n3), rhs(n3), dlambda(n3 / 3), fixed(n3), free(n3) {}
+  std::vector<real> known;  // known increments: Δu_τ = v_12 (sticking), Δu_z = v_4 / s (contact)
   std::vector<real> h;      // H_1 blocks (h11 | h12 | h22) of sliding nodes
-  std::vector<real> rhs;    // r_F: (I + H_1) v_12 on sliding rows, v_3 + v_4 on separated u_z rows
+  std::vector<real> rhs;    // r_F: (s I + H_1) v_12 on sliding rows, v_3 + v_4 on separated u_z rows
+  std::vector<real> dlambda;  // Δλ = v_4 (separated), −v_3 (contact: plus (S Δu)_z)
   std::vector<std::uint8_t> fixed, free;  // per dof: increment known / part of F
 };
 
-// Fills L from the node status and the approximation step (v, d); returns
-// whether any known increment is nonzero.
-bool linearise(index p, const std::vector<real>& phi, const std::vector<std::uint8_t>& status, const std::vector<real>& v,
+// Fills L from the node status and the approximation step d at scale s
+// (contact_maps.hpp): with v_12 = d_12 − u_τ, v_4 = d_4 − lambda the scaled
+// step's increments and v_3 = v̂_3, the linearisation of (8) at (x, d̂) gives
+//   sticking: Δu_τ = v_12;  sliding: (S Δu)_τ + H_1 Δu_τ = (s I + H_1) v_12
+//   contact: Δu_z = v_4 / s;  separated: Δλ = v_4, (S Δu)_z = v_3 + v_4
+// (s = 1: the paper's (G A + H) Δ = (G + H) v̂). Returns whether any known
+// increment is nonzero.
+bool linearise(index p, const ContactConditions& law, const real* scale, const std::vector<real>& u,
+               const std::vector<real>& lambda, const std::vector<std::uint8_t>& status, const std::vector<real>& vhat,
                const std::vector<real>& d, ReducedSystem& L) {
   bool any_known = false;
   for (index i = 0; i < p; ++i) {
     const bool stick = status[i] & kStick, contact = status[i] & kContact;
-    const real v1 = v[i], v2 = v[p + i], v3 = v[2 * p + i], v4 = v[3 * p + i];
+    const real s = scale ? scale[i] : 1;
+    const real v1 = d[i] - u[i], v2 = d[p + i] - u[p + i], v3 = vhat[2 * p + i], v4 = d[2 * p + i] - lambda[i];
     L.fixed[i] = L.fixed[p + i] = stick;
     L.fixed[2 * p + i] = contact;
     L.free[i] = L.free[p + i] = !stick;
     L.free[2 * p + i] = !contact;
     real h11 = 0, h12 = 0, h22 = 0;
-    if (!stick) sliding_block(phi[i], d[i], d[p + i], h11, h12, h22);
+    if (!stick) sliding_block(law.phi[i], d[i], d[p + i], h11, h12, h22);
     L.h[i] = h11;
     L.h[p + i] = h12;
     L.h[2 * p + i] = h22;
     L.known[i] = stick ? v1 : 0;
     L.known[p + i] = stick ? v2 : 0;
-    L.known[2 * p + i] = contact ? v4 : 0;
-    L.rhs[i] = stick ? 0 : v1 + h11 * v1 + h12 * v2;
-    L.rhs[p + i] = stick ? 0 : v2 + h12 * v1 + h22 * v2;
+    L.known[2 * p + i] = contact ? v4 / s : 0;
+    L.dlambda[i] = contact ? -v3 : v4;  // + (S Δu)_z on contact nodes, after the solve
+    L.rhs[i] = stick ? 0 : s * v1 + h11 * v1 + h12 * v2;
+    L.rhs[p + i] = stick ? 0 : s * v2 + h12 * v1 + h22 * v2;
     L.rhs[2 * p + i] = contact ? 0 : v3 + v4;
     any_known = any_known || L.known[i] != 0 || L.known[p + i] != 0 || L.known[2 * p + i] != 0;
   }
@@ -117,17 +126,20 @@ struct StepOutcome {
   bool inner_failed = false;
 };
 
-// Solves the reduced system of L for Δu (into du) and S Δu (into Sdu), to
-// the absolute accuracy `target` (semismooth.hpp: Tolerances).
-StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreconditioner* M, real target,
+// Solves the reduced system of L for Δu_F (into du) to the relative
+// accuracy eta (forcing term; semismooth.hpp: Tolerances), floored at the
+// absolute `floor`; Sdu gets the CG's running estimate of S Δu (inexact).
+StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreconditioner* M, real eta, real floor,
                        bool any_known, InnerWork& work, CGWorkspace& ws, std::vector<real>& du,
                        std::vector<real>& Sdu, std::vector<real>& scratch) {
   const index n3 = S.size();
   StepOutcome out;
   const long long fails0 = work.failures;
-  // known increments enter the right-hand side: r_F -= (S Δu_known)_F
+  // known increments enter the right-hand side: r_F -= (S Δu_known)_F; an
+  // error there is an error of the step, so the inner accuracy follows eta
+  const real inner_max = 1e-2;
   if (any_known) {
-    if (!work.apply(S, L.known.data(), scratch.data(), 1e-12)) {
+    if (!work.apply(S, L.known.data(), scratch.data(), std::clamp(0.1 * eta, real(1e-12), inner_max))) {
       out.inner_failed = true;
       return out;
     }
@@ -139,12 +151,13 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
   if (M) M->update(L.h, L.fixed, L.free);
   ReducedNewtonOperator A(S, L, work);
   CGOptions co;
+  const real target = std::max(floor, eta * norm2(n3, L.rhs.data()));
   co.rtol = 1e-13;  // attainable floor relative to |rhs|
   co.atol = target;
   co.max_iterations = M ? 200 : 5000;
   // relaxed inner accuracy (Simoncini–Szyld): the perturbation of S may grow
   // like target/|r_j| as the outer residual r_j falls
-  co.on_residual = [&](real rn) { A.set_inner_rtol(std::clamp(0.1 * target / rn, 1e-12, 1e-2)); };
+  co.on_residual = [&](real rn) { A.set_inner_rtol(std::clamp(0.1 * target / rn, real(1e-12), inner_max)); };
   co.abort_if = [&] { return work.failures > fails0; };  // an S apply is untrustworthy
   {
     ScopedTimer t(Kernel::outer_cg);
@@ -152,12 +165,22 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
   }
   if (M) work.fine_matvecs += out.outer.preconditioner_applications * M->apply_work();
   out.inner_failed = work.failures > fails0;
-  // S Δu = S Δu_F (accumulated by CG) + S Δu_known
   axpy(n3, 1, scratch.data(), Sdu.data());
   return out;
 }
 
 }  // namespace
+
+std::vector<real> step_scale(const SteklovPoincare& S) {
+  const std::vector<real> kd = S.K().diagonal();
+  const index p = S.size() / 3, N = S.problem().nodes();
+  std::vector<real> s(p);
+  for (index c = 0; c < p; ++c) {
+    const index n = S.problem().contact_grid_node(c);
+    s[c] = (kd[n] + kd[N + n] + kd[2 * N + n]) / 3;
+  }
+  return s;
+}
 
 bool stagnated(const std::vector<real>& h, int w) {
   const int k = int(h.size());
@@ -213,14 +236,21 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   if (opt.outer_pc == OuterPreconditioner::multigrid)
     M = std::make_unique<BoundaryPreconditioner>(S, S.interior_multigrid().options());
   CGWorkspace ws;
+  // the approximation step's metric (contact_maps.hpp): the paper's (s = 1) or
+  // s_i = mean diagonal of K_cc at contact node i
+  std::vector<real> scale;
+  if (opt.scaling == StepScaling::diagonal) scale = step_scale(S);
+  const real* scale_ptr = scale.empty() ? nullptr : scale.data();
 
+  const real bnorm = norm2(n3, btilde.data());
+  real eta = opt.forcing_max;
   for (int k = 0;; ++k) {
     // 1. approximation step at x = (u, lambda), r = S u - b̃
     real vnorm;
     {
       ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
       for (index i = 0; i < n3; ++i) r[i] = R.Su[i] - btilde[i];
-      vnorm = std::sqrt(approximation_step(p, law.law(), R.u.data(), R.lambda.data(), r.data(), v.data(), d.data(),
+      vnorm = std::sqrt(approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), r.data(), v.data(), d.data(),
                                            R.status.data()));
     }
     R.history.push_back(vnorm);
@@ -238,14 +268,17 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     if (stagnated(R.history, opt.stagnation_window)) return finish(NewtonReason::stagnation);
 
     // 2. linearisation: known increments, free set, H, right-hand side
-    const bool any_known = linearise(p, phi, R.status, v, d, L);
-    // Accuracy of the step, absolute: decisions compare forces with phi and
-    // u_z, so early steps must be near-exact (1e-10 |v0|); late steps need
-    // only a fraction of |v_k|; nothing below 0.1 eps is useful.
-    const real target = std::max(0.1 * opt.eps, std::min(opt.step_accuracy * vnorm, 1e-10 * R.history[0]));
+    const bool any_known = linearise(p, law, scale_ptr, R.u, R.lambda, R.status, v, d, L);
+    // Forcing term (Eisenstat–Walker, choice 2, safeguarded): the step is
+    // solved to eta_k relative, eta_k -> 0 as |v̂| falls (superlinear).
+    if (k > 0) {
+      const real ratio = vnorm / R.history[k - 1], prev = eta;
+      eta = std::min(opt.forcing_max, real(0.9) * ratio * ratio);
+      if (0.9 * prev * prev > 0.1) eta = std::max(eta, real(0.9) * prev * prev);
+    }
 
     // 3. the reduced Newton system, by preconditioned CG on the boundary
-    const StepOutcome step = solve_step(S, L, M.get(), target, any_known, work, ws, du, Sdu, scratch);
+    const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * opt.eps, any_known, work, ws, du, Sdu, scratch);
     R.outer_iterations += step.outer.iterations;
     R.operator_applications += step.outer.iterations + (any_known ? 1 : 0);
     if (step.inner_failed) return finish(NewtonReason::inner_failure);
@@ -253,10 +286,18 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     if (step.outer.reason == SolveReason::breakdown) return finish(NewtonReason::inner_failure);
     if (step.outer.reason == SolveReason::max_iterations) R.outer_limit_hits += 1;  // inexact step taken
 
-    // 4. update x = (u, lambda) and S u
+    // 4. update x = (u, lambda) and S u. The step may be inexact, but S Δu
+    // must be accurate: S u is kept incrementally and its error stays in every
+    // later residual. One application of S to the whole Δu, to an absolute
+    // accuracy of book_accuracy |b̃| (relative to the CG's estimate of S Δu).
     for (index i = 0; i < n3; ++i) du[i] += L.known[i];
+    const real sdu_norm = norm2(n3, Sdu.data());
+    const real book_rtol =
+        sdu_norm > 0 ? std::clamp(opt.book_accuracy * bnorm / sdu_norm, real(1e-12), real(1e-1)) : real(1e-1);
+    R.operator_applications += 1;
+    if (!work.apply(S, du.data(), Sdu.data(), book_rtol)) return finish(NewtonReason::inner_failure);
     for (index i = 0; i < p; ++i)
-      R.lambda[i] += (R.status[i] & kContact) ? Sdu[2 * p + i] - v[2 * p + i] : v[3 * p + i];
+      R.lambda[i] += L.dlambda[i] + ((R.status[i] & kContact) ? Sdu[2 * p + i] : 0);
     axpy(n3, 1, du.data(), R.u.data());
     axpy(n3, 1, Sdu.data(), R.Su.data());
     R.iterations = k + 1;

@@ -2,25 +2,30 @@
 // (paper Section 4, method.md §3–5), matrix-free on the contact boundary.
 //
 // Iteration k, x = (u, lambda), r = S u − b̃ kept current incrementally:
-//  1. approximation step (kernels/contact_maps.hpp) → v̂, d̂, node status;
-//     stop when ||v̂||_2 <= eps (paper's rule (11));
-//  2. Newton step (9)–(10) in reduced form: known increments Δu_τ = v_12
-//     (sticking), Δu_z = v_4 (contact), Δλ = v_4 (separated); free dofs F =
-//     u_τ of sliding nodes, u_z of separated nodes solve the SPD system
+//  1. approximation step (kernels/contact_maps.hpp) at scale s → d̂, node
+//     status; the paper's v̂ (s = 1) for the stopping rule ||v̂||_2 <= eps (11);
+//  2. Newton step (9)–(10) in reduced form, with v = d̂ − x the step's
+//     increments: known Δu_τ = v_12 (sticking), Δu_z = v_4/s (contact),
+//     Δλ = v_4 (separated); free dofs F = u_τ of sliding nodes, u_z of
+//     separated nodes solve the SPD system
 //       (S + H)_FF Δu_F = r_F − S_F,known Δu_known
-//     with r = (I + H_1) v_12 on sliding rows, v_3 + v_4 on separated rows,
+//     with r = (s I + H_1) v_12 on sliding rows, v_3 + v_4 on separated rows,
 //     by CG preconditioned with BoundaryPreconditioner; then
 //     Δλ = (S Δu)_z − v_3 on contact nodes.
-//  3. S u += S Δu, reusing the S products of the CG iterations (one extra S
-//     application per step, for the known part).
-// Tolerances. The decisions of the approximation step compare forces with phi
-// (1 N against nodal forces of 1e7 N in the benchmark), so a step is solved to
-// the absolute accuracy
-//   target_k = max(0.1 eps, min(step_accuracy ||v̂_k||, 1e-10 ||v̂_0||)),
-// near-exact early, a fraction of ||v̂_k|| late (forcing-term style). The inner
-// (K_ii) accuracy is relaxed as the outer residual r_j falls:
-//   inner rtol_j = clamp(0.1 target_k / ||r_j||, 1e-12, 1e-2).
-// Cost per step: (outer iterations + 1) S applications = inner MG-CG solves.
+//  3. S u += S Δu, with S Δu from one application of S to the whole step.
+// Tolerances. The step is inexact: CG stops at eta_k |r_F| (forcing term,
+// Eisenstat–Walker choice 2: eta_0 = forcing_max, then 0.9 (|v̂_k|/|v̂_k-1|)²,
+// safeguarded, so eta_k -> 0 and the convergence stays superlinear), floored
+// at 0.1 eps. Its inner (K_ii) solves are relaxed as the outer residual r_j
+// falls: inner rtol_j = clamp(0.1 target / ||r_j||, 1e-12, 1e-2). S Δu for
+// the bookkeeping of S u must be accurate whatever eta (its error stays in
+// every later residual): to book_accuracy |b̃| absolute, i.e. a tight solve
+// for the large early steps and a loose one for the small late ones.
+// The paper's unscaled step compares forces with displacements (1 N against
+// nodal forces of 1e7 N), so an error of 1e-8 in a force moves its decisions:
+// it needs eta = 1e-10 (NewtonOptions::paper_method()). The scaled step
+// compares both in consistent units and takes eta_0 = 1e-2.
+// Cost per step: outer iterations + 2 S applications = inner MG-CG solves.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -45,17 +50,32 @@ struct NewtonProgress {
 
 enum class OuterPreconditioner { multigrid, none };
 
+// Metric of the approximation step (contact_maps.hpp): the paper's (s = 1:
+// forces and displacements added as numbers) or a stiffness per contact node
+// from the diagonal of K_cc (consistent units; issue 9, item 4).
+enum class StepScaling { paper, diagonal };
+
 struct NewtonOptions {
   real eps = 1e-6;
   // preconditioner of the reduced boundary system: one V-cycle of K + B
   // (boundary_preconditioner.hpp), or none (plain CG, for comparison)
   OuterPreconditioner outer_pc = OuterPreconditioner::multigrid;
   int max_iterations = 50;
-  real step_accuracy = 1e-3;  // late steps are solved to this fraction of ||v̂_k||
+  StepScaling scaling = StepScaling::diagonal;
+  real forcing_max = 1e-2;     // largest relative accuracy of a Newton step (the first)
+  real book_accuracy = 1e-12;  // absolute accuracy of each S Δu, relative to |b̃|
   // stop when the largest ||v̂|| of the last `stagnation_window` steps is not
   // below half the largest of the window before (a lucky dip does not count)
   int stagnation_window = 4;
   std::function<void(const NewtonProgress&)> progress;
+  // The paper's method: unscaled approximation step, whose decisions compare
+  // forces with displacements, so its steps must be near-exact.
+  static NewtonOptions paper_method() {
+    NewtonOptions o;
+    o.scaling = StepScaling::paper;
+    o.forcing_max = 1e-10;
+    return o;
+  }
   // optional initial iterate (default x0 = 0): u0 (3p) and lambda0 (p);
   // S u0 is then formed with a tight inner solve
   const std::vector<real>* u0 = nullptr;
@@ -90,6 +110,11 @@ struct ContactConditions {
   static ContactConditions uniform(index p, real phi, real gap) { return {std::vector<real>(p, phi), std::vector<real>(p, gap)}; }
   ContactLaw law() const { return {phi.data(), gap.data()}; }
 };
+
+// s_i = (K_xx + K_yy + K_zz)/3 at contact node i [N/m]: the diagonal of S
+// is smaller, but the iteration counts do not depend on a factor in 0.25..2
+// (perf/RESULTS.md), so the plain diagonal of K_cc it is
+std::vector<real> step_scale(const SteklovPoincare& S);
 
 NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
                                const NewtonOptions& opt);
