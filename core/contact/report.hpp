@@ -29,7 +29,8 @@ struct FinalReport {
   SolveStats inner;                   // the tight inner solve behind S u
 };
 
+// extension (optional): E u (3N SoA) from the same tight solve
 FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
-                         const NewtonResult& R, real tight_rtol = 1e-12);
+                         const NewtonResult& R, real tight_rtol = 1e-12, std::vector<real>* extension = nullptr);
 
 }  // namespace tresca

@@ -1,7 +1,8 @@
 // One complete solve of the contact problem, with the timings of the paper's
 // Table 1 columns: setup (mesh, operators, multigrid hierarchy), condense
-// (b̃ = condensed load), solve (semismooth* Newton), recover (final check
-// with a tight S apply + interior displacement).
+// (b̃ = condensed load, keeping K_ii^{-1} l_i), solve (semismooth* Newton),
+// recover (final check: one tight S apply, whose harmonic extension gives the
+// body's displacement u = E u_c + K_ii^{-1} l_i without another solve).
 #pragma once
 #include <functional>
 #include <memory>
@@ -34,10 +35,10 @@ struct RunResult {
   ContactConditions contact;  // the law used at each contact node
   FinalReport report;
   std::vector<real> u_full;  // 3N SoA (empty if not recovered)
-  long long inner_iterations = 0;  // over the whole run, including condensation and recovery
+  long long inner_iterations = 0;  // over the whole run, including condensation and the final check
   // work in fine-grid matvec equivalents (the Newton phase alone is
-  // newton.fine_matvecs): the whole run, condensed load, Newton, the final
-  // tight check and the recovery
+  // newton.fine_matvecs): the whole run, condensed load, Newton and the
+  // final tight check (which includes the recovery)
   double fine_matvecs_total = 0;
   double peak_memory = 0;  // bytes, process peak resident set after the run
   double fine_matvecs_per_newton_step() const {

@@ -55,7 +55,7 @@ void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
   }
 }
 
-SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol) const {
+SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* extension) const {
   // Invariants between calls: w_ is zero off the contact nodes, t_ is zero
   // off plane 1, so only plane-sized work surrounds the inner solve.
   const GridDims& g = P_.grid;
@@ -71,6 +71,7 @@ SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol) const {
   K_.apply_planes(z_.data(), t_.data(), 0, 1);
   gather(t_.data(), Sv);
   set_plane(t_.data(), 0, nullptr);
+  if (extension) copy(3 * N, z_.data(), extension);
   return st;
 }
 
@@ -78,7 +79,7 @@ double SteklovPoincare::apply_work(long long inner_iterations) const {
   return double(inner_iterations) * (1 + mg_.cycle_work()) + 2.0 / double(P_.grid.nz());
 }
 
-SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b) const {
+SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior) const {
   std::vector<real> li(P_.load);
   zero_constrained(P_.grid, P_.interior_faces, li.data());
   const SolveStats st = solve_interior(li.data(), z_.data(), rtol);
@@ -89,21 +90,7 @@ SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b) cons
   set_plane(t_.data(), 0, nullptr);
   gather(P_.load.data(), lc.data());
   for (index i = 0; i < 3 * p_; ++i) b[i] = lc[i] - b[i];
-  return st;
-}
-
-SolveStats SteklovPoincare::recover(const real* uc, real rtol, std::vector<real>& u) const {
-  // rhs = l_i - K_ic u_c (K_ic u_c lives on plane 1); u = w + K_ii^{-1} rhs.
-  // Reuses w_ and t_ (no extra full-size vectors at peak), then restores t_.
-  const index n = 3 * P_.nodes();
-  u.resize(n);
-  scatter(uc, w_.data());
-  K_.apply_planes(w_.data(), t_.data(), 1, 2);
-  xpay(n, P_.load.data(), -1, t_.data());
-  zero_constrained(P_.grid, P_.interior_faces, t_.data());
-  const SolveStats st = solve_interior(t_.data(), u.data(), rtol);
-  set_plane(u.data(), 0, w_.data());
-  fill<real>(n, 0, t_.data());
+  if (interior) interior->assign(z_.begin(), z_.end());
   return st;
 }
 

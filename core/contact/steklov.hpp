@@ -3,7 +3,7 @@
 //
 //   S v = K_cc v − K_ci K_ii^{-1} K_ic v = (K E v)_c ,
 //   b̃  = l_c − K_ci K_ii^{-1} l_i ,
-//   u_i = K_ii^{-1} (l_i − K_ic u_c)            (interior recovery)
+//   u   = E u_c + K_ii^{-1} l_i                  (recovery of the body)
 //
 // where E v = w + z is the discrete harmonic extension: w = v on the contact
 // face (zero elsewhere) and K_ii z = −K_ic v. K has u = 0 on x = 0; K_ii also
@@ -32,12 +32,15 @@ class SteklovPoincare {
  public:
   SteklovPoincare(const Problem& P, const MGOptions& mg = {});
   index size() const { return 3 * p_; }
-  // Sv = S v with the inner K_ii solve to relative tolerance rtol
-  SolveStats apply(const real* v, real* Sv, real rtol) const;
-  // b = b̃ (3p) with the inner solve to relative tolerance rtol
-  SolveStats condensed_load(real rtol, std::vector<real>& b) const;
-  // u = full SoA displacement (3N) from contact values u_c
-  SolveStats recover(const real* uc, real rtol, std::vector<real>& u) const;
+  // Sv = S v with the inner K_ii solve to relative tolerance rtol; with
+  // `extension`, also E v there (3N SoA: v on the contact face, the discrete
+  // harmonic extension inside, 0 on x = 0)
+  SolveStats apply(const real* v, real* Sv, real rtol, real* extension = nullptr) const;
+  // b = b̃ (3p) with the inner solve to relative tolerance rtol; with
+  // `interior`, also K_ii^{-1} l_i there (3N SoA). The body's displacement
+  // for contact values u_c is then E u_c + K_ii^{-1} l_i: recovery costs no
+  // solve beyond the final check's S u_c.
+  SolveStats condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior = nullptr) const;
 
   const Multigrid& interior_multigrid() const { return mg_; }  // its options() also serve the Newton step
   // work of one apply in fine-grid matvec equivalents, given the inner CG
