@@ -19,7 +19,7 @@ static const char* kHelp =
     "with multigrid-preconditioned CG and prints a summary. Default: --level 6 --rtol 1e-10.\n";
 
 int main(int argc, char** argv) {
-  default_wait_policy(argv);
+  default_runtime_environment(argv);
   try {
     Args a(argc, argv, {"--level", "--dims", "--E", "--nu", "--rtol", "--threads"}, {"--help"});
     if (a.has("--help")) {

@@ -66,7 +66,7 @@ const PaperRow* paper_row(int level) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  default_wait_policy(argv);
+  default_runtime_environment(argv);
   ProblemSpec spec;
   RunOptions opt;
   int threads = 1;

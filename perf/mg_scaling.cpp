@@ -13,7 +13,7 @@
 using namespace tresca;
 
 int main(int argc, char** argv) {
-  default_wait_policy(argv);
+  default_runtime_environment(argv);
   try {
     Args a(argc, argv, {"--levels", "--rtol", "--threads", "--json", "--precision"}, {"--help"});
     if (a.has("--help")) {

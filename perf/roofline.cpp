@@ -99,7 +99,7 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  default_wait_policy(argv);
+  default_runtime_environment(argv);
   try {
     Args a(argc, argv, {"--level", "--threads", "--reps", "--json"}, {"--help"});
     if (a.has("--help")) {

@@ -26,7 +26,7 @@
 using namespace tresca;
 
 int main(int argc, char** argv) {
-  default_wait_policy(argv);
+  default_runtime_environment(argv);
   try {
     Args a(argc, argv, {"--levels", "--threads", "--phi", "--json"}, {"--help"});
     if (a.has("--help")) {

@@ -1,5 +1,6 @@
 #include "core/io/cli.hpp"
 
+#include <utility>
 #include <omp.h>
 #include <unistd.h>
 
@@ -121,10 +122,15 @@ void check_memory(const ProblemSpec& s) {
   }
 }
 
-void default_wait_policy(char** argv) {
-  if (std::getenv("OMP_WAIT_POLICY")) return;
-  setenv("OMP_WAIT_POLICY", "passive", 0);
-  execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
+void default_runtime_environment(char** argv) {
+  bool changed = false;
+  for (const auto& [name, value] : {std::pair<const char*, const char*>{"OMP_WAIT_POLICY", "passive"},
+                                    {"GLIBC_TUNABLES", "glibc.malloc.hugetlb=1"}})
+    if (!std::getenv(name)) {
+      setenv(name, value, 0);
+      changed = true;
+    }
+  if (changed) execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
 }
 
 int apply_threads(const Args& a) {

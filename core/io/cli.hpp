@@ -30,14 +30,17 @@ ProblemSpec spec_from_args(const Args& a, int default_level);
 std::vector<int> parse_level_range(const std::string& s);
 // throws if the estimated memory of a run exceeds the machine's physical memory
 void check_memory(const ProblemSpec& s);
-// The drivers' OpenMP default: threads that wait passively (sleep) instead of
-// spinning. Spinning is 4% faster on an idle machine at level 10, but when
-// another process holds a core the spinning threads slow a run by 2-4x
-// (perf/RESULTS.md). libgomp reads OMP_WAIT_POLICY once, when it is loaded, so
-// if the variable is unset this re-executes the program once with
-// OMP_WAIT_POLICY=passive; a user's own setting is always kept. Call it first
-// in main.
-void default_wait_policy(char** argv);
+// The drivers' runtime defaults, read by libgomp and glibc only when the
+// process starts, so if a variable is unset this re-executes the program once
+// with it set; a user's own setting is always kept. Call it first in main.
+// - OMP_WAIT_POLICY=passive: threads that wait sleep instead of spinning.
+//   Spinning is 4% faster on an idle machine at level 10, but when another
+//   process holds a core the spinning threads slow a run by 2-4x.
+// - GLIBC_TUNABLES=glibc.malloc.hugetlb=1: malloc asks for transparent huge
+//   pages (where the kernel's THP mode is "madvise", as on Debian). First
+//   touch of the large arrays costs 512x fewer page faults: level 11 setup
+//   1.7 -> 0.7 s, the whole run 13.6 -> 9.9 s (perf/RESULTS.md §0d).
+void default_runtime_environment(char** argv);
 // --threads N (else OMP_NUM_THREADS / all cores); returns the thread count in use
 int apply_threads(const Args& a);
 std::string dims_string(const ProblemSpec& s);
