@@ -108,7 +108,7 @@ TEST(TrescaDriver, WritesJsonCsvAndVtk) {
   for (const char* key : {"\"level\": null", "\"dims\": [6, 3, 2]", "\"nodes\": 84", "\"contact_nodes\": 24",
                           "\"dofs\"", "\"phi\": 10000000", "\"eps\"", "\"threads\"", "\"newton_iterations\"",
                           "\"converged\": true", "\"reason\": \"converged\"", "\"residual_history\": [",
-                          "\"final_residual\"", "\"true_residual\"", "\"true_residual_relative\"", "\"times\": {\"setup\"",
+                          "\"final_residual\"", "\"true_residual\"", "\"true_residual_relative\"", "\"times\": {\"nested\"", "\"setup\"", "\"nested\": [",
                           "\"condense\"", "\"solve\"", "\"recover\"", "\"total\"", "\"counts\": {\"inner_iterations\"",
                           "\"outer_iterations\"", "\"operator_applications\"", "\"contact\": {\"active\"", "\"separated\"",
                           "\"sticking\"", "\"sliding\"", "\"ux_min\"", "\"uz_max\"", "\"lambda_sum\""})

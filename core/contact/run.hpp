@@ -19,13 +19,32 @@ struct RunOptions {
   // called after each phase with its name and duration (progress on long runs)
   std::function<void(const char* phase, double seconds)> phase_done;
   bool recover_interior = true;  // full 3D displacement (needed for VTK output)
+  // nested iteration (nested.hpp): coarser meshes first, down to meshes of
+  // at least nested_min_contact_nodes contact nodes; off: x0 = 0 (the paper)
+  bool nested = true;
+  index nested_min_contact_nodes = 64;
+  // the coarse meshes stop at |v̂| <= nested_rtol |v̂_0| (their solutions
+  // differ from the fine one by the discretisation error anyway) and skip
+  // the final check
+  real nested_rtol = 1e-4;
+  bool final_check = true;  // the independent check (report.hpp), which also recovers u; off only for nested coarse meshes
   real tight_rtol = 1e-12;
   // the contact law per node (p values each); empty: spec.phi and spec.gap at every node
   ContactConditions contact;
 };
 
 struct RunTimes {
+  double nested = 0;  // the coarser meshes' solves of nested iteration
   double setup = 0, condense = 0, solve = 0, recover = 0, total = 0;
+};
+
+// One coarse mesh of a nested run: what its solve took.
+struct NestedLevel {
+  ProblemSpec spec;
+  int newton_iterations = 0;
+  bool converged = false;
+  double fine_matvecs = 0;  // in matvecs of that coarse mesh
+  double seconds = 0;
 };
 
 struct RunResult {
@@ -41,6 +60,9 @@ struct RunResult {
   // final tight check (which includes the recovery)
   double fine_matvecs_total = 0;
   double peak_memory = 0;  // bytes, process peak resident set after the run
+  // the coarse meshes of nested iteration, coarsest first (empty: cold start);
+  // fine_matvecs_total includes their work, scaled by their share of the dofs
+  std::vector<NestedLevel> nested;
   double fine_matvecs_per_newton_step() const {
     return newton.iterations > 0 ? newton.fine_matvecs / newton.iterations : 0;
   }

@@ -263,7 +263,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
       opt.progress(pr);
     }
     if (!std::isfinite(vnorm)) return finish(NewtonReason::non_finite);
-    if (vnorm <= opt.eps) return finish(NewtonReason::converged);
+    const real tol = std::max(opt.eps, opt.rtol * R.history[0]);
+    if (vnorm <= tol) return finish(NewtonReason::converged);
     if (k >= opt.max_iterations) return finish(NewtonReason::iteration_limit);
     if (stagnated(R.history, opt.stagnation_window)) return finish(NewtonReason::stagnation);
 
@@ -278,7 +279,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     }
 
     // 3. the reduced Newton system, by preconditioned CG on the boundary
-    const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * opt.eps, any_known, work, ws, du, Sdu, scratch);
+    const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * tol, any_known, work, ws, du, Sdu, scratch);
     R.outer_iterations += step.outer.iterations;
     R.operator_applications += step.outer.iterations + (any_known ? 1 : 0);
     if (step.inner_failed) return finish(NewtonReason::inner_failure);

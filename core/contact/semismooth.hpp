@@ -57,6 +57,7 @@ enum class StepScaling { paper, diagonal };
 
 struct NewtonOptions {
   real eps = 1e-6;
+  real rtol = 0;  // stop at ||v̂|| <= max(eps, rtol ||v̂_0||) (0: the paper's absolute rule)
   // preconditioner of the reduced boundary system: one V-cycle of K + B
   // (boundary_preconditioner.hpp), or none (plain CG, for comparison)
   OuterPreconditioner outer_pc = OuterPreconditioner::multigrid;

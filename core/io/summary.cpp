@@ -13,7 +13,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   const FinalReport& F = R.report;
   const NewtonResult& N = R.newton;
   Json times, counts, contact, kkt;
-  times.num("setup", R.times.setup).num("condense", R.times.condense).num("solve", R.times.solve)
+  times.num("nested", R.times.nested).num("setup", R.times.setup).num("condense", R.times.condense).num("solve", R.times.solve)
       .num("recover", R.times.recover).num("total", R.times.total);
   counts.integer("inner_iterations", R.inner_iterations).integer("outer_iterations", N.outer_iterations)
       .integer("operator_applications", N.operator_applications)
@@ -26,6 +26,15 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   kkt.num("equilibrium", F.equilibrium).num("uz_violation", F.uz_violation).num("lambda_violation", F.lambda_violation)
       .num("complementarity", F.complementarity).num("friction_bound", F.friction_bound)
       .num("friction_direction", F.friction_direction).num("stick_slip", F.stick_slip);
+  std::string nested = "[";
+  for (const NestedLevel& l : R.nested) {
+    Json n;
+    n.raw("dims", "[" + std::to_string(l.spec.ex) + ", " + std::to_string(l.spec.ey) + ", " + std::to_string(l.spec.ez) + "]")
+        .integer("newton_iterations", l.newton_iterations).boolean("converged", l.converged)
+        .num("fine_matvecs_own", l.fine_matvecs).num("seconds", l.seconds);
+    nested += (nested.size() > 1 ? ", " : "") + n.render();
+  }
+  nested += "]";
   Json j;
   if (spec.level >= 0)
     j.integer("level", spec.level);
@@ -39,7 +48,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
       .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())
       .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
       .raw("times", times.render()).raw("counts", counts.render()).raw("contact", contact.render())
-      .raw("kkt", kkt.render()).num("peak_memory_bytes", R.peak_memory);
+      .raw("kkt", kkt.render()).raw("nested", nested).num("peak_memory_bytes", R.peak_memory);
   return j;
 }
 
