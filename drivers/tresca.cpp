@@ -135,6 +135,12 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       };
     if (!quiet)
+      opt.nested_done = [](const NestedLevel& l) {
+        std::printf("  nested: mesh %s solved in %d Newton steps%s: %.2f s\n", dims_string(l.spec).c_str(),
+                    l.newton_iterations, l.converged ? "" : " (not converged: not used)", l.seconds);
+        std::fflush(stdout);
+      };
+    if (!quiet)
       opt.newton.progress = [](const NewtonProgress& p) {
         std::printf("  it %2d  |v| %10.3e  contact %7lld  separated %7lld  stick %7lld  slip %7lld  inner %7lld  outer %5lld  %8.2f s\n",
                     p.iteration, p.residual, (long long)p.active, (long long)p.separated, (long long)p.sticking,

@@ -13,8 +13,9 @@ constexpr real kPenalty = 1e4;
 
 BoundaryPreconditioner::BoundaryPreconditioner(const SteklovPoincare& S, const MGOptions& mg)
     : S_(S),
-      mg_(S.interior_multigrid().hierarchy(),  // the K_ii solver's grids and transfers
-          elasticity_on(S.problem().dirichlet_faces, S.problem().spec.E, S.problem().spec.nu), mg) {
+      mg_(S.interior_multigrid().hierarchy(),  // the K_ii solver's grids, transfers and smoother bounds
+          elasticity_on(S.problem().dirichlet_faces, S.problem().spec.E, S.problem().spec.nu), mg,
+          S.interior_multigrid()) {
   const GridDims& g = S.problem().grid;
   const index M = g.nx() * g.ny(), N = g.nodes();
   const std::vector<real> d = mg_.op(0).diagonal();

@@ -9,13 +9,14 @@
 namespace tresca {
 
 FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
-                         const NewtonResult& R, real tight_rtol, std::vector<real>* extension) {
+                         const NewtonResult& R, real tight_rtol, std::vector<real>* extension, bool warm) {
   const index p = S.size() / 3;
   const std::vector<real>& phi = law.phi;
   FinalReport F;
   std::vector<real> Su(3 * p), v(4 * p), d(3 * p);
   if (extension) extension->resize(3 * S.problem().nodes());
-  F.inner = S.apply(R.u.data(), Su.data(), tight_rtol, extension ? extension->data() : nullptr);
+  real* ext = extension ? extension->data() : nullptr;
+  F.inner = S.apply(R.u.data(), Su.data(), tight_rtol, ext, warm ? ext : nullptr);
   F.r.resize(3 * p);
   for (index i = 0; i < 3 * p; ++i) F.r[i] = Su[i] - btilde[i];
   F.status.resize(p);

@@ -29,8 +29,10 @@ struct FinalReport {
   SolveStats inner;                   // the tight inner solve behind S u
 };
 
-// extension (optional): E u (3N SoA) from the same tight solve
+// extension (optional): E u (3N SoA) from the same tight solve; with
+// `warm`, it holds an initial guess of E u on entry
 FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
-                         const NewtonResult& R, real tight_rtol = 1e-12, std::vector<real>* extension = nullptr);
+                         const NewtonResult& R, real tight_rtol = 1e-12, std::vector<real>* extension = nullptr,
+                         bool warm = false);
 
 }  // namespace tresca

@@ -1,8 +1,9 @@
 #include "core/contact/run.hpp"
 
-#include <string>
+#include <algorithm>
 
 #include "core/contact/nested.hpp"
+#include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
 
@@ -16,32 +17,40 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
                   ? ContactConditions::uniform(R.problem->contact_nodes(), spec.phi, spec.gap)
                   : opt.contact;
   // nested iteration: the coarser mesh first (before this mesh's operators
-  // exist, so the peak memory stays this mesh's), its (u, lambda) carried here
+  // exist, so the peak memory stays this mesh's). It hands up (u, lambda)
+  // as the Newton initial iterate and, trilinearly interpolated, its K_ii^{-1}
+  // l_i and E u as initial guesses of this mesh's tight inner solves.
   NewtonOptions newton = opt.newton;
-  std::vector<real> u0, lambda0;
-  double nested_work = 0;
+  std::vector<real> u0, lambda0, load_guess, extension;  // extension: E u0, then E u
   if (opt.nested && !newton.u0 && has_coarser(spec, opt.nested_min_contact_nodes)) {
     const ProblemSpec cs = coarser_spec(spec);
     RunOptions co = opt;
-    co.recover_interior = false;
+    co.recover_interior = true;
     co.newton.progress = nullptr;
+    co.phase_done = nullptr;  // one line per coarse mesh: nested_done
     co.newton.rtol = opt.nested_rtol;
-    co.final_check = false;
+    // and need their forces only to a fraction of that accuracy
+    co.tight_rtol = std::max(opt.tight_rtol, 1e-3 * opt.nested_rtol);
+    co.newton.book_accuracy = std::max(opt.newton.book_accuracy, 1e-3 * opt.nested_rtol);
     co.contact = coarse_conditions(*R.problem, R.contact, make_problem(cs));
     const RunResult C = run_tresca(cs, co);
     R.nested = C.nested;
-    R.nested.push_back({cs, C.newton.iterations, C.newton.converged(), C.fine_matvecs_total, C.times.total});
-    nested_work = C.fine_matvecs_total * double(cs.free_dofs()) / double(spec.free_dofs());
-    if (opt.phase_done) {
-      const std::string what = "nested: mesh " + std::to_string(cs.ex) + "x" + std::to_string(cs.ey) + "x" +
-                               std::to_string(cs.ez) + ", " + std::to_string(C.newton.iterations) + " Newton steps" +
-                               (C.newton.converged() ? "" : " (not converged: not used)");
-      opt.phase_done(what.c_str(), C.times.total);
-    }
+    R.nested.push_back({cs, C.newton.iterations, C.newton.converged(), C.fine_matvecs_total - C.nested_fine_matvecs,
+                        C.times.total - C.times.nested});
+    R.nested_fine_matvecs = C.fine_matvecs_total * double(cs.free_dofs()) / double(spec.free_dofs());
+    if (opt.nested_done) opt.nested_done(R.nested.back());
     if (C.newton.converged()) {
       prolongate_contact(*C.problem, C.newton.u, C.newton.lambda, *R.problem, u0, lambda0);
       newton.u0 = &u0;
       newton.lambda0 = &lambda0;
+      const Transfer T = build_transfer(R.problem->grid, C.problem->grid);
+      const index n = R.problem->dofs();
+      load_guess.resize(n);
+      extension.resize(n);
+      prolongate(T, 3, C.interior_load.data(), load_guess.data());
+      prolongate(T, 3, C.u_full.data(), extension.data());  // E u_c + K_ii^{-1} l_i
+      axpy(n, -1, load_guess.data(), extension.data());
+      newton.extension0 = &extension;
     }
   }
   const double t0s = wall_time();
@@ -49,8 +58,9 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   const double t1 = wall_time();
   if (opt.phase_done) opt.phase_done("setup (mesh, operators, multigrid)", t1 - t0s);
   std::vector<real> btilde;
-  std::vector<real> interior_load;  // K_ii^{-1} l_i, for the recovery
-  const SolveStats cond = S.condensed_load(opt.tight_rtol, btilde, opt.recover_interior ? &interior_load : nullptr);
+  const SolveStats cond = S.condensed_load(opt.tight_rtol, btilde, &R.interior_load,
+                                           load_guess.empty() ? nullptr : load_guess.data());
+  load_guess = {};
   const double t2 = wall_time();
   if (opt.phase_done) opt.phase_done("condensed load", t2 - t1);
   if (!cond.ok()) {
@@ -65,10 +75,15 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   }
   const double t3 = wall_time();
   if (opt.phase_done) opt.phase_done("semismooth* Newton", t3 - t2);
-  // the final check's tight S u also gives E u: u = E u + K_ii^{-1} l_i
-  if (opt.final_check) {
-    R.report = final_report(S, btilde, R.contact, R.newton, opt.tight_rtol, opt.recover_interior ? &R.u_full : nullptr);
-    if (opt.recover_interior) axpy(index(R.u_full.size()), 1, interior_load.data(), R.u_full.data());
+  // the final check's tight S u, warm from E u0 when there is one, also
+  // gives E u: u = E u + K_ii^{-1} l_i
+  const bool warm = !extension.empty();
+  R.report = final_report(S, btilde, R.contact, R.newton, opt.tight_rtol, &extension, warm);
+  if (opt.recover_interior) {
+    R.u_full = std::move(extension);
+    axpy(index(R.u_full.size()), 1, R.interior_load.data(), R.u_full.data());
+  } else {
+    R.interior_load = {};
   }
   const double t4 = wall_time();
   if (opt.phase_done) opt.phase_done("final check and recovery", t4 - t3);
@@ -80,7 +95,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.times.total = t4 - t0;
   R.inner_iterations = cond.iterations + R.newton.inner_iterations + R.report.inner.iterations;
   R.fine_matvecs_total =
-      nested_work + R.newton.fine_matvecs + S.apply_work(cond.iterations) + S.apply_work(R.report.inner.iterations);
+      R.nested_fine_matvecs + R.newton.fine_matvecs + S.apply_work(cond.iterations) + S.apply_work(R.report.inner.iterations);
   R.peak_memory = peak_memory_bytes();
   return R;
 }

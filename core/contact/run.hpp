@@ -13,21 +13,31 @@
 
 namespace tresca {
 
+// One coarse mesh of a nested run: what its solve took.
+struct NestedLevel {
+  ProblemSpec spec;
+  int newton_iterations = 0;
+  bool converged = false;
+  double fine_matvecs = 0;  // its own work (without coarser meshes), in matvecs of that mesh
+  double seconds = 0;       // its own time (without coarser meshes)
+};
+
 struct RunOptions {
   NewtonOptions newton;
   MGOptions mg;  // both V-cycles: the inner K_ii solve and the Newton-step preconditioner
   // called after each phase with its name and duration (progress on long runs)
   std::function<void(const char* phase, double seconds)> phase_done;
+  // called after each coarse mesh of nested iteration, coarsest first
+  std::function<void(const NestedLevel&)> nested_done;
   bool recover_interior = true;  // full 3D displacement (needed for VTK output)
   // nested iteration (nested.hpp): coarser meshes first, down to meshes of
   // at least nested_min_contact_nodes contact nodes; off: x0 = 0 (the paper)
   bool nested = true;
   index nested_min_contact_nodes = 64;
   // the coarse meshes stop at |v̂| <= nested_rtol |v̂_0| (their solutions
-  // differ from the fine one by the discretisation error anyway) and skip
-  // the final check
+  // differ from the fine one by the discretisation error anyway) and
+  // compute b̃ and S u to 1e-3 nested_rtol
   real nested_rtol = 1e-4;
-  bool final_check = true;  // the independent check (report.hpp), which also recovers u; off only for nested coarse meshes
   real tight_rtol = 1e-12;
   // the contact law per node (p values each); empty: spec.phi and spec.gap at every node
   ContactConditions contact;
@@ -38,22 +48,14 @@ struct RunTimes {
   double setup = 0, condense = 0, solve = 0, recover = 0, total = 0;
 };
 
-// One coarse mesh of a nested run: what its solve took.
-struct NestedLevel {
-  ProblemSpec spec;
-  int newton_iterations = 0;
-  bool converged = false;
-  double fine_matvecs = 0;  // in matvecs of that coarse mesh
-  double seconds = 0;
-};
-
 struct RunResult {
   std::unique_ptr<Problem> problem;
   RunTimes times;
   NewtonResult newton;
   ContactConditions contact;  // the law used at each contact node
   FinalReport report;
-  std::vector<real> u_full;  // 3N SoA (empty if not recovered)
+  std::vector<real> u_full;         // 3N SoA (empty if not recovered)
+  std::vector<real> interior_load;  // K_ii^{-1} l_i, 3N SoA (kept with u_full, for nested iteration)
   long long inner_iterations = 0;  // over the whole run, including condensation and the final check
   // work in fine-grid matvec equivalents (the Newton phase alone is
   // newton.fine_matvecs): the whole run, condensed load, Newton and the
@@ -63,6 +65,7 @@ struct RunResult {
   // the coarse meshes of nested iteration, coarsest first (empty: cold start);
   // fine_matvecs_total includes their work, scaled by their share of the dofs
   std::vector<NestedLevel> nested;
+  double nested_fine_matvecs = 0;  // their work in this mesh's matvecs
   double fine_matvecs_per_newton_step() const {
     return newton.iterations > 0 ? newton.fine_matvecs / newton.iterations : 0;
   }

@@ -31,8 +31,9 @@ struct InnerWork {
   long long iterations = 0, failures = 0;
   double fine_matvecs = 0;  // SteklovPoincare::apply_work of each application
   // one application of S at inner tolerance rtol, counted; false if the inner solve failed
-  bool apply(const SteklovPoincare& S, const real* v, real* Sv, real rtol) {
-    const SolveStats st = S.apply(v, Sv, rtol);
+  bool apply(const SteklovPoincare& S, const real* v, real* Sv, real rtol, real* extension = nullptr,
+             const real* guess = nullptr) {
+    const SolveStats st = S.apply(v, Sv, rtol, extension, guess);
     iterations += st.iterations;
     failures += st.ok() ? 0 : 1;
     fine_matvecs += S.apply_work(st.iterations);
@@ -228,7 +229,14 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     R.u = *opt.u0;
     R.lambda = *opt.lambda0;
     R.operator_applications += 1;
-    if (!work.apply(S, R.u.data(), R.Su.data(), 1e-12)) return finish(NewtonReason::inner_failure);
+    // S u0 starts the bookkeeping of S u: the same accuracy as every S Δu
+    real* ext = nullptr;
+    if (opt.extension0) {
+      opt.extension0->resize(3 * S.problem().nodes());
+      ext = opt.extension0->data();
+    }
+    if (!work.apply(S, R.u.data(), R.Su.data(), std::max(opt.book_accuracy, real(1e-12)), ext, ext))
+      return finish(NewtonReason::inner_failure);
   }
   std::vector<real> r(n3), v(4 * p), d(3 * p), du(n3), Sdu(n3), scratch(n3);
   ReducedSystem L(n3);

@@ -81,6 +81,9 @@ struct NewtonOptions {
   // S u0 is then formed with a tight inner solve
   const std::vector<real>* u0 = nullptr;
   const std::vector<real>* lambda0 = nullptr;
+  // optional, with u0: on entry an initial guess of E u0 (3N, steklov.hpp)
+  // for that solve, on return E u0
+  std::vector<real>* extension0 = nullptr;
 };
 
 struct NewtonResult {

@@ -35,10 +35,15 @@ void SteklovPoincare::gather(const real* full, real* vc) const {
   }
 }
 
-SolveStats SteklovPoincare::solve_interior(const real* rhs, real* z, real rtol) const {
+SolveStats SteklovPoincare::solve_interior(const real* rhs, real* z, real rtol, const real* guess) const {
   ScopedTimer t(Kernel::inner_cg);
   CGOptions o;
   o.rtol = rtol;
+  if (guess) {
+    copy(3 * P_.nodes(), guess, z);
+    zero_constrained(P_.grid, P_.interior_faces, z);  // the guess of an extension carries v on plane 0
+    o.zero_initial_guess = false;
+  }
   o.max_iterations = 500;
   return pcg(mg_.op(0), &mg_, rhs, z, o, ws_);
 }
@@ -55,7 +60,7 @@ void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
   }
 }
 
-SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* extension) const {
+SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* extension, const real* guess) const {
   // Invariants between calls: w_ is zero off the contact nodes, t_ is zero
   // off plane 1, so only plane-sized work surrounds the inner solve.
   const GridDims& g = P_.grid;
@@ -64,7 +69,7 @@ SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* exte
   // t = -K_ic v lives on plane 1 (w_ is zero on the x = 0 nodes, so are t's)
   K_.apply_planes(w_.data(), t_.data(), 1, 2);
   for (int a = 0; a < 3; ++a) scale(plane, -1, t_.data() + a * N + plane);
-  const SolveStats st = solve_interior(t_.data(), z_.data(), rtol);
+  const SolveStats st = solve_interior(t_.data(), z_.data(), rtol, guess);
   // u = w + z: z vanishes on the constrained plane 0, where w lives
   set_plane(z_.data(), 0, w_.data());
   // Sv = (K u)_c on plane 0, then restore t_'s invariant
@@ -79,10 +84,11 @@ double SteklovPoincare::apply_work(long long inner_iterations) const {
   return double(inner_iterations) * (1 + mg_.cycle_work()) + 2.0 / double(P_.grid.nz());
 }
 
-SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior) const {
+SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior,
+                                           const real* guess) const {
   std::vector<real> li(P_.load);
   zero_constrained(P_.grid, P_.interior_faces, li.data());
-  const SolveStats st = solve_interior(li.data(), z_.data(), rtol);
+  const SolveStats st = solve_interior(li.data(), z_.data(), rtol, guess);
   K_.apply_planes(z_.data(), t_.data(), 0, 1);
   std::vector<real> lc(3 * p_);
   b.resize(3 * p_);

@@ -32,15 +32,19 @@ class SteklovPoincare {
  public:
   SteklovPoincare(const Problem& P, const MGOptions& mg = {});
   index size() const { return 3 * p_; }
-  // Sv = S v with the inner K_ii solve to relative tolerance rtol; with
-  // `extension`, also E v there (3N SoA: v on the contact face, the discrete
-  // harmonic extension inside, 0 on x = 0)
-  SolveStats apply(const real* v, real* Sv, real rtol, real* extension = nullptr) const;
+  // Sv = S v with the inner K_ii solve to relative tolerance rtol (of the
+  // solve's right-hand side, so a good initial guess means fewer iterations,
+  // not a looser answer); with `extension`, also E v there (3N SoA: v on the
+  // contact face, the discrete harmonic extension inside, 0 on x = 0). guess
+  // (3N, may be `extension` itself): initial guess of E v for the inner solve.
+  SolveStats apply(const real* v, real* Sv, real rtol, real* extension = nullptr, const real* guess = nullptr) const;
   // b = b̃ (3p) with the inner solve to relative tolerance rtol; with
   // `interior`, also K_ii^{-1} l_i there (3N SoA). The body's displacement
   // for contact values u_c is then E u_c + K_ii^{-1} l_i: recovery costs no
   // solve beyond the final check's S u_c.
-  SolveStats condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior = nullptr) const;
+  // guess (3N): initial guess of K_ii^{-1} l_i.
+  SolveStats condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior = nullptr,
+                            const real* guess = nullptr) const;
 
   const Multigrid& interior_multigrid() const { return mg_; }  // its options() also serve the Newton step
   // work of one apply in fine-grid matvec equivalents, given the inner CG
@@ -55,7 +59,7 @@ class SteklovPoincare {
   void gather(const real* full, real* vc) const;
 
  private:
-  SolveStats solve_interior(const real* rhs, real* z, real rtol) const;
+  SolveStats solve_interior(const real* rhs, real* z, real rtol, const real* guess = nullptr) const;
   // plane iz of all 3 components of v := src's (or 0 if src is null)
   void set_plane(real* v, index iz, const real* src) const;
 

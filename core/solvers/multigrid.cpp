@@ -55,8 +55,18 @@ Multigrid::Multigrid(const GridDims& fine, unsigned faces, real E, real nu, cons
     : Multigrid(GridHierarchy::build(fine, opt.coarse_nodes), elasticity_on(faces, E, nu), opt) {}
 
 Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt)
+    : Multigrid(std::move(grids), op, opt, nullptr) {}
+
+Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt,
+                     const Multigrid& like)
+    : Multigrid(std::move(grids), op, opt, &like) {}
+
+Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt,
+                     const Multigrid* like)
     : opt_(opt), grids_(std::move(grids)) {
   if (!grids_ || grids_->grids.empty()) throw std::invalid_argument("multigrid: empty grid hierarchy");
+  if (like && like->grids_ != grids_)
+    throw std::invalid_argument("multigrid: spectral bounds can only be shared on the same hierarchy");
   for (const GridDims& g : grids_->grids) {
     Level lv;
     lv.A = op(g);
@@ -64,7 +74,12 @@ Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscret
       throw std::invalid_argument("multigrid: the rediscretised operator does not live on the hierarchy's grid");
     levels_.push_back(std::move(lv));
   }
-  for (size_t l = 0; l + 1 < levels_.size(); ++l) estimate_lmax(levels_[l]);
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) {
+    if (like)
+      levels_[l].lmax = like->levels_[l].lmax;
+    else
+      estimate_lmax(levels_[l]);
+  }
   factor_coarse();
   if (opt_.precision == Precision::single_precision)
     build_work<float>();
