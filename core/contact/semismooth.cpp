@@ -158,7 +158,7 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
   co.max_iterations = M ? 200 : 5000;
   // relaxed inner accuracy (Simoncini–Szyld): the perturbation of S may grow
   // like target/|r_j| as the outer residual r_j falls
-  co.on_residual = [&](real rn) { A.set_inner_rtol(std::clamp(0.1 * target / rn, real(1e-12), inner_max)); };
+  co.on_residual = [&](real rn) { A.set_inner_rtol(std::clamp(target / rn, real(1e-12), inner_max)); };
   co.abort_if = [&] { return work.failures > fails0; };  // an S apply is untrustworthy
   {
     ScopedTimer t(Kernel::outer_cg);
