@@ -18,7 +18,7 @@
 // safeguarded, so eta_k -> 0 and the convergence stays superlinear), floored
 // at 0.1 eps. Its inner (K_ii) solves are relaxed as the outer residual r_j
 // falls: inner rtol_j = clamp(target / ||r_j||, 1e-12, 1e-2) (a safety factor 0.1 cost
-// 6-13% more work and never a Newton step, perf/RESULTS.md §0c). S Δu for
+// 6-13% more work and saved no Newton step, perf/RESULTS.md §0c). S Δu for
 // the bookkeeping of S u must be accurate whatever eta (its error stays in
 // every later residual): to book_accuracy |b̃| absolute, i.e. a tight solve
 // for the large early steps and a loose one for the small late ones.
