@@ -24,6 +24,8 @@ const char* kHelp =
     "  --level L          mesh level (default 6): ex = ceil(4*2^(L/2)), ey = ez = ceil(2*2^(L/2))\n"
     "  --dims EXxEYxEZ    explicit element counts instead of a level\n"
     "  --phi F            Tresca friction bound per contact node [N] (default 1)\n"
+    "  --coulomb F        Coulomb friction, bound phi_i = F lambda_i per contact node (F >= 0),\n"
+    "                     by a fixed point on Tresca; excludes --phi\n"
     "  --gap G            the rigid plane lies G >= 0 metres below the contact face (default 0)\n"
     "  --eps E            stopping tolerance on ||v|| (default 1e-6, absolute)\n"
     "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
@@ -77,7 +79,7 @@ int main(int argc, char** argv) {
   try {
     const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling"},
+                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb"},
                   {"--quiet", "--help", "--profile", "--no-nested"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
@@ -107,6 +109,13 @@ int main(int argc, char** argv) {
     if (prec != "single" && prec != "double")
       throw std::invalid_argument("--mg-precision '" + prec + "' must be single or double");
     opt.mg.precision = prec == "single" ? Precision::single_precision : Precision::double_precision;
+    if (a.has("--coulomb")) {
+      opt.coulomb = a.real_value("--coulomb", 0);
+      if (!(opt.coulomb >= 0) || !std::isfinite(opt.coulomb))
+        throw std::invalid_argument("--coulomb " + a.str("--coulomb") + " must be a friction coefficient >= 0");
+      if (a.has("--phi")) throw std::invalid_argument("--coulomb and --phi exclude each other (Coulomb: phi_i = F lambda_i)");
+      if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's Tresca case; it takes no --coulomb");
+    }
     opt.nested = !a.has("--no-nested") && table.empty();  // --table: the paper's cold start
     quiet = a.has("--quiet");
     profile = a.has("--profile");
@@ -172,7 +181,7 @@ int main(int argc, char** argv) {
                     R.times.solve, R.newton.iterations, R.newton.converged() ? "yes" : "NO", pbuf,
                     R.report.true_residual, R.report.true_residual_relative);
         std::fflush(stdout);
-        all = all && R.newton.converged();
+        all = all && R.converged();
         rows += (rows.size() > 1 ? ",\n " : "") + run_summary(s, R, threads, opt).render();
       }
       if (!json_path.empty()) write_file_atomic(json_path, rows + "]\n");
@@ -192,6 +201,15 @@ int main(int argc, char** argv) {
     const FinalReport& F = R.report;
     char last[64] = "n/a (no approximation step)";
     if (!N.history.empty()) std::snprintf(last, sizeof last, "%.3e", N.history.back());
+    if (R.coulomb) {
+      const CoulombResult& C = R.coulomb_loop;
+      std::printf("Coulomb F = %g: %s after %d Tresca solves, %lld Newton steps in all (reason: %s); changes of phi:",
+                  opt.coulomb, C.converged() ? "converged" : "NOT CONVERGED", C.iterations, C.newton_steps,
+                  to_string(C.reason));
+      for (real c : C.changes) std::printf(" %.1e", c);
+      std::printf("\nthe last Tresca solve (phi_i = F lambda_i of the one before, max |phi_i - F lambda_i| = %.2e N):\n",
+                  R.coulomb_consistency);
+    }
     std::printf("%s after %d Newton iterations (reason: %s), final |v| %s (eps %.1e)\n",
                 N.converged() ? "converged" : "NOT CONVERGED", N.iterations, to_string(N.reason), last,
                 opt.newton.eps);
@@ -226,7 +244,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "tresca: error: %s\n", e.what());
       return 3;
     }
-    return N.converged() ? 0 : 1;
+    return R.converged() ? 0 : 1;
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());
     return 2;

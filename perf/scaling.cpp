@@ -85,12 +85,12 @@ int main(int argc, char** argv) {
         const double speedup = t_first / R.times.total;
         std::printf("%5d %3d %10lld %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %6d %6lld %6lld %6lld %8.1f %8.1f %9.1f %8.1f %6.1f %8.2f %7.2f %s\n",
                     L, T, (long long)R.problem->free_dofs(), R.times.nested, R.times.setup, R.times.condense,
-                    R.times.solve, R.times.recover, R.times.total, R.newton.iterations, R.newton.outer_iterations,
+                    R.times.solve, R.times.recover, R.times.total, int(R.newton_steps()), R.newton.outer_iterations,
                     R.inner_iterations, R.newton.operator_applications, R.fine_matvecs_per_newton_step(),
                     R.nested_fine_matvecs, R.fine_matvecs_total, fmv_linear,
                     R.fine_matvecs_total / fmv_linear, R.peak_memory / 1e9, speedup,
-                    R.newton.converged() ? "" : to_string(R.newton.reason));
-        all_converged = all_converged && R.newton.converged();
+                    R.converged() ? "" : R.reason().c_str());
+        all_converged = all_converged && R.converged();
         std::fflush(stdout);
         Json j = run_summary(s, R, T, o);
         j.num("speedup", speedup).num("fine_matvecs_linear_solve", fmv_linear)

@@ -1,6 +1,7 @@
 #include "core/contact/run.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/contact/nested.hpp"
 #include "kernels/transfer.hpp"
@@ -29,17 +30,18 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     co.newton.progress = nullptr;
     co.phase_done = nullptr;  // one line per coarse mesh: nested_done
     co.newton.rtol = opt.nested_rtol;
+    co.coulomb_tol = std::max(opt.coulomb_tol, opt.nested_rtol);
     // and need their forces only to a fraction of that accuracy
     co.tight_rtol = std::max(opt.tight_rtol, 1e-3 * opt.nested_rtol);
     co.newton.book_accuracy = std::max(opt.newton.book_accuracy, 1e-3 * opt.nested_rtol);
     co.contact = coarse_conditions(*R.problem, R.contact, make_problem(cs));
     const RunResult C = run_tresca(cs, co);
     R.nested = C.nested;
-    R.nested.push_back({cs, C.newton.iterations, C.newton.converged(), C.fine_matvecs_total - C.nested_fine_matvecs,
+    R.nested.push_back({cs, int(C.newton_steps()), C.converged(), C.fine_matvecs_total - C.nested_fine_matvecs,
                         C.times.total - C.times.nested});
     R.nested_fine_matvecs = C.fine_matvecs_total * double(cs.free_dofs()) / double(spec.free_dofs());
     if (opt.nested_done) opt.nested_done(R.nested.back());
-    if (C.newton.converged()) {
+    if (C.converged()) {
       prolongate_contact(*C.problem, C.newton.u, C.newton.lambda, *R.problem, u0, lambda0);
       newton.u0 = &u0;
       newton.lambda0 = &lambda0;
@@ -70,6 +72,18 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.newton.u.assign(3 * p, 0);
     R.newton.lambda.assign(p, 0);
     R.newton.status.assign(p, 0);
+  } else if (opt.coulomb >= 0) {
+    CoulombOptions co;
+    co.F = opt.coulomb;
+    co.tol = opt.coulomb_tol;
+    R.coulomb = true;
+    R.coulomb_loop = coulomb_fixed_point(S, btilde, R.contact, co, newton);
+    R.newton = std::move(R.coulomb_loop.last);
+    R.coulomb_loop.last = {};
+    R.contact = R.coulomb_loop.law;
+    for (index i = 0; i < R.problem->contact_nodes(); ++i)
+      R.coulomb_consistency = std::max(R.coulomb_consistency,
+                                       std::abs(R.contact.phi[i] - co.F * std::max(real(0), R.newton.lambda[i])));
   } else {
     R.newton = semismooth_newton(S, btilde, R.contact, newton);
   }
@@ -93,9 +107,10 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.times.solve = t3 - t2;
   R.times.recover = t4 - t3;
   R.times.total = t4 - t0;
-  R.inner_iterations = cond.iterations + R.newton.inner_iterations + R.report.inner.iterations;
-  R.fine_matvecs_total =
-      R.nested_fine_matvecs + R.newton.fine_matvecs + S.apply_work(cond.iterations) + S.apply_work(R.report.inner.iterations);
+  const long long newton_inner = R.coulomb ? R.coulomb_loop.inner_iterations : R.newton.inner_iterations;
+  R.inner_iterations = cond.iterations + newton_inner + R.report.inner.iterations;
+  R.fine_matvecs_total = R.nested_fine_matvecs + R.newton_fine_matvecs() + S.apply_work(cond.iterations) +
+                         S.apply_work(R.report.inner.iterations);
   R.peak_memory = peak_memory_bytes();
   return R;
 }

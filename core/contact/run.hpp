@@ -6,8 +6,10 @@
 #pragma once
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
+#include "core/contact/coulomb.hpp"
 #include "core/contact/report.hpp"
 #include "core/contact/semismooth.hpp"
 
@@ -41,6 +43,10 @@ struct RunOptions {
   real tight_rtol = 1e-12;
   // the contact law per node (p values each); empty: spec.phi and spec.gap at every node
   ContactConditions contact;
+  // Coulomb friction (coulomb.hpp): coefficient F >= 0 makes the bound
+  // phi_i = F lambda_i (contact.phi / spec.phi are then not used); < 0: Tresca
+  real coulomb = -1;
+  real coulomb_tol = 1e-6;  // the fixed point's stop on the relative change of phi (coarse meshes: nested_rtol)
 };
 
 struct RunTimes {
@@ -51,8 +57,16 @@ struct RunTimes {
 struct RunResult {
   std::unique_ptr<Problem> problem;
   RunTimes times;
-  NewtonResult newton;
-  ContactConditions contact;  // the law used at each contact node
+  NewtonResult newton;        // the (last) Tresca solve
+  ContactConditions contact;  // the law used at each contact node (Coulomb: the last bound F lambda)
+  // Coulomb: the fixed point's account (its `last` moved into newton)
+  bool coulomb = false;
+  CoulombResult coulomb_loop;
+  real coulomb_consistency = 0;  // max_i |phi_i - F lambda_i| at the solution [N]
+  bool converged() const { return newton.converged() && (!coulomb || coulomb_loop.converged()); }
+  std::string reason() const {
+    return !newton.converged() || !coulomb ? to_string(newton.reason) : to_string(coulomb_loop.reason);
+  }
   FinalReport report;
   std::vector<real> u_full;         // 3N SoA (empty if not recovered)
   std::vector<real> interior_load;  // K_ii^{-1} l_i, 3N SoA (kept with u_full, for nested iteration)
@@ -66,8 +80,10 @@ struct RunResult {
   // fine_matvecs_total includes their work, scaled by their share of the dofs
   std::vector<NestedLevel> nested;
   double nested_fine_matvecs = 0;  // their work in this mesh's matvecs
+  long long newton_steps() const { return coulomb ? coulomb_loop.newton_steps : newton.iterations; }
+  double newton_fine_matvecs() const { return coulomb ? coulomb_loop.fine_matvecs : newton.fine_matvecs; }
   double fine_matvecs_per_newton_step() const {
-    return newton.iterations > 0 ? newton.fine_matvecs / newton.iterations : 0;
+    return newton_steps() > 0 ? newton_fine_matvecs() / double(newton_steps()) : 0;
   }
 };
 

@@ -225,18 +225,23 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     R.fine_matvecs = work.fine_matvecs;
     return R;
   };
+  if (opt.Su0 && index(opt.Su0->size()) != n3) size_error("Su0", opt.Su0->size(), n3);
   if (opt.u0 && opt.lambda0) {
     R.u = *opt.u0;
     R.lambda = *opt.lambda0;
-    R.operator_applications += 1;
-    // S u0 starts the bookkeeping of S u: the same accuracy as every S Δu
-    real* ext = nullptr;
-    if (opt.extension0) {
-      opt.extension0->resize(3 * S.problem().nodes());
-      ext = opt.extension0->data();
+    if (opt.Su0) {
+      R.Su = *opt.Su0;
+    } else {
+      // S u0 starts the bookkeeping of S u: the same accuracy as every S Δu
+      R.operator_applications += 1;
+      real* ext = nullptr;
+      if (opt.extension0) {
+        opt.extension0->resize(3 * S.problem().nodes());
+        ext = opt.extension0->data();
+      }
+      if (!work.apply(S, R.u.data(), R.Su.data(), std::max(opt.book_accuracy, real(1e-12)), ext, ext))
+        return finish(NewtonReason::inner_failure);
     }
-    if (!work.apply(S, R.u.data(), R.Su.data(), std::max(opt.book_accuracy, real(1e-12)), ext, ext))
-      return finish(NewtonReason::inner_failure);
   }
   std::vector<real> r(n3), v(4 * p), d(3 * p), du(n3), Sdu(n3), scratch(n3);
   ReducedSystem L(n3);

@@ -85,6 +85,9 @@ struct NewtonOptions {
   // optional, with u0: on entry an initial guess of E u0 (3N, steklov.hpp)
   // for that solve, on return E u0
   std::vector<real>* extension0 = nullptr;
+  // optional, with u0: S u0 itself (3p), e.g. the tracked S u of an earlier
+  // solve from which this one continues; then no solve is needed for it
+  const std::vector<real>* Su0 = nullptr;
 };
 
 struct NewtonResult {

@@ -20,7 +20,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
       .integer("newton_inner_iterations", N.inner_iterations)
       .integer("outer_limit_hits", N.outer_limit_hits)
       .num("fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step())
-      .num("fine_matvecs_solve", R.newton.fine_matvecs).num("fine_matvecs_total", R.fine_matvecs_total);
+      .num("fine_matvecs_solve", R.newton_fine_matvecs()).num("fine_matvecs_total", R.fine_matvecs_total);
   contact.integer("active", F.active).integer("separated", F.separated).integer("sticking", F.sticking)
       .integer("sliding", F.sliding).num("ux_min", F.ux_min).num("uz_max", F.uz_max).num("lambda_sum", F.lambda_sum);
   kkt.num("equilibrium", F.equilibrium).num("uz_violation", F.uz_violation).num("lambda_violation", F.lambda_violation)
@@ -35,6 +35,13 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
     nested += (nested.size() > 1 ? ", " : "") + n.render();
   }
   nested += "]";
+  Json coulomb;
+  if (R.coulomb) {
+    const CoulombResult& C = R.coulomb_loop;
+    coulomb.num("F", opt.coulomb).integer("fixed_point_iterations", C.iterations)
+        .str("reason", to_string(C.reason)).boolean("converged", C.converged()).array("changes", C.changes)
+        .integer("newton_steps", C.newton_steps).num("consistency", R.coulomb_consistency);
+  }
   Json j;
   if (spec.level >= 0)
     j.integer("level", spec.level);
@@ -42,13 +49,14 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
     j.null("level");
   j.raw("dims", "[" + std::to_string(spec.ex) + ", " + std::to_string(spec.ey) + ", " + std::to_string(spec.ez) + "]")
       .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
-      .num("phi", spec.phi).num("gap", spec.gap).num("eps", eps).integer("threads", threads).str("build", build_info())
+      .str("friction", R.coulomb ? "coulomb" : "tresca")
+      .num("phi", R.coulomb ? NAN : spec.phi).num("gap", spec.gap).num("eps", eps).integer("threads", threads).str("build", build_info())
       .str("mg_precision", to_string(opt.mg.precision)).integer("newton_iterations", N.iterations)
-      .boolean("converged", N.converged()).str("reason", to_string(N.reason))
+      .boolean("converged", R.converged()).str("reason", R.reason())
       .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())
       .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
       .raw("times", times.render()).raw("counts", counts.render()).raw("contact", contact.render())
-      .raw("kkt", kkt.render()).raw("nested", nested).num("peak_memory_bytes", R.peak_memory);
+      .raw("kkt", kkt.render()).raw("nested", nested).raw("coulomb", R.coulomb ? coulomb.render() : "null").num("peak_memory_bytes", R.peak_memory);
   return j;
 }
 

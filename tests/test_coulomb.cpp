@@ -1,0 +1,102 @@
+// Coulomb friction by the fixed point on Tresca (core/contact/coulomb.hpp):
+// the converged solution is a fixed point, F = 0 is frictionless, and the
+// report is honest when the fixed point is cut short.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/contact/run.hpp"
+#include "test_helpers.hpp"
+
+namespace tresca {
+
+namespace {
+RunResult solve(const ProblemSpec& spec, real F, bool nested = true) {
+  RunOptions o;
+  o.recover_interior = false;
+  o.coulomb = F;
+  o.nested = nested;
+  o.nested_min_contact_nodes = 40;
+  return run_tresca(spec, o);
+}
+}  // namespace
+
+TEST(Coulomb, ConvergedSolutionIsAFixedPointOfTresca) {
+  // 32x16x16, F = 1.5: nodes stick, slide and separate (at F = 0.8 none
+  // sticks on this mesh). Re-solving Tresca from scratch with
+  // phi_i = F lambda_i of the Coulomb solution reproduces it.
+  const ProblemSpec spec = spec_for_dims(32, 16, 16);
+  const real F = 1.5;
+  const RunResult C = solve(spec, F);
+  ASSERT_TRUE(C.converged()) << C.reason();
+  ASSERT_TRUE(C.coulomb);
+  EXPECT_GT(C.coulomb_loop.iterations, 1);
+  EXPECT_GT(C.report.sticking, 0);
+  EXPECT_GT(C.report.sliding, 0);
+  EXPECT_GT(C.report.separated, 0);
+  const index p = C.problem->contact_nodes();
+  RunOptions o;
+  o.recover_interior = false;
+  o.nested = false;
+  o.contact = ContactConditions::uniform(p, 0, 0);
+  for (index i = 0; i < p; ++i) o.contact.phi[i] = F * std::max(real(0), C.newton.lambda[i]);
+  const RunResult T = run_tresca(spec, o);
+  ASSERT_TRUE(T.converged());
+  // the fixed point stops at a relative change of 1e-6 in phi
+  EXPECT_LT(test::max_abs_diff(T.newton.u, C.newton.u), 1e-5 * test::max_abs(C.newton.u));
+  EXPECT_LT(test::max_abs_diff(T.newton.lambda, C.newton.lambda), 1e-5 * test::max_abs(C.newton.lambda));
+  EXPECT_TRUE(T.report.status == C.report.status);
+  EXPECT_LT(C.coulomb_consistency, 1e-5 * F * test::max_abs(C.newton.lambda));
+  // and the friction law holds with phi_i = F lambda_i: |r_t| <= F lambda on
+  // every node, to the fixed point's tolerance 1e-6 max phi (twice, for
+  // the last solve's own change)
+  const real slack = 2e-6 * F * test::max_abs(C.newton.lambda) + 1e-3;
+  for (index i = 0; i < p; ++i)
+    EXPECT_LE(std::hypot(C.report.r[i], C.report.r[p + i]), F * std::max(real(0), C.newton.lambda[i]) + slack) << i;
+}
+
+TEST(Coulomb, ZeroCoefficientIsFrictionless) {
+  ProblemSpec spec = spec_for_dims(16, 8, 8);
+  const RunResult C = solve(spec, 0);
+  spec.phi = 0;
+  RunOptions o;
+  o.recover_interior = false;
+  const RunResult T = run_tresca(spec, o);
+  ASSERT_TRUE(C.converged());
+  ASSERT_TRUE(T.converged());
+  EXPECT_LT(test::max_abs_diff(T.newton.u, C.newton.u), 1e-8 * test::max_abs(T.newton.u));
+  EXPECT_LT(test::max_abs_diff(T.newton.lambda, C.newton.lambda), 1e-8 * test::max_abs(T.newton.lambda));
+}
+
+TEST(Coulomb, NestedAndColdReachTheSameSolution) {
+  const ProblemSpec spec = spec_for_dims(16, 8, 8);
+  const RunResult a = solve(spec, 0.3, true), b = solve(spec, 0.3, false);
+  ASSERT_TRUE(a.converged());
+  ASSERT_TRUE(b.converged());
+  EXPECT_FALSE(a.nested.empty());
+  EXPECT_LT(test::max_abs_diff(a.newton.u, b.newton.u), 1e-5 * test::max_abs(b.newton.u));
+  EXPECT_TRUE(a.report.status == b.report.status);
+}
+
+TEST(Coulomb, ReportsAnIterationLimitOfTheFixedPoint) {
+  // one Tresca solve cannot make phi = F lambda consistent: not converged, and said so
+  const Problem P = make_problem(spec_for_dims(8, 4, 4));
+  SteklovPoincare S(P);
+  std::vector<real> b;
+  ASSERT_TRUE(S.condensed_load(1e-12, b).ok());
+  CoulombOptions co;
+  co.F = 0.5;
+  co.max_iterations = 1;
+  const CoulombResult C =
+      coulomb_fixed_point(S, b, ContactConditions::uniform(P.contact_nodes(), 0, 0), co, NewtonOptions{});
+  EXPECT_FALSE(C.converged());
+  EXPECT_EQ(C.reason, CoulombReason::iteration_limit);
+  EXPECT_EQ(C.iterations, 1);
+  ASSERT_EQ(C.changes.size(), 1u);
+  EXPECT_GT(C.changes[0], 0.5);  // from frictionless to F lambda: phi changes entirely
+  co.F = -1;
+  EXPECT_THROW(coulomb_fixed_point(S, b, ContactConditions::uniform(P.contact_nodes(), 0, 0), co, NewtonOptions{}),
+               std::invalid_argument);
+}
+
+}  // namespace tresca
