@@ -25,7 +25,9 @@ const char* kHelp =
     "  --dims EXxEYxEZ    explicit element counts instead of a level\n"
     "  --phi F            Tresca friction bound per contact node [N] (default 1)\n"
     "  --coulomb F        Coulomb friction, bound phi_i = F lambda_i per contact node (F >= 0),\n"
-    "                     by a fixed point on Tresca; excludes --phi\n"
+    "                     excludes --phi\n"
+    "  --coulomb-method lagged|fixed-point  the bound follows lambda at every Newton step of\n"
+    "                     one solve (default), or a fixed point of whole Tresca solves\n"
     "  --gap G            the rigid plane lies G >= 0 metres below the contact face (default 0)\n"
     "  --eps E            stopping tolerance on ||v|| (default 1e-6, absolute)\n"
     "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
@@ -79,7 +81,7 @@ int main(int argc, char** argv) {
   try {
     const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb"},
+                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb", "--coulomb-method"},
                   {"--quiet", "--help", "--profile", "--no-nested"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
@@ -115,6 +117,10 @@ int main(int argc, char** argv) {
         throw std::invalid_argument("--coulomb " + a.str("--coulomb") + " must be a friction coefficient >= 0");
       if (a.has("--phi")) throw std::invalid_argument("--coulomb and --phi exclude each other (Coulomb: phi_i = F lambda_i)");
       if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's Tresca case; it takes no --coulomb");
+      const std::string m = a.str("--coulomb-method", "lagged");
+      if (m != "lagged" && m != "fixed-point")
+        throw std::invalid_argument("--coulomb-method '" + m + "' must be lagged or fixed-point");
+      opt.coulomb_method = m == "lagged" ? RunOptions::CoulombMethod::lagged : RunOptions::CoulombMethod::fixed_point;
     }
     opt.nested = !a.has("--no-nested") && table.empty();  // --table: the paper's cold start
     quiet = a.has("--quiet");
@@ -203,12 +209,20 @@ int main(int argc, char** argv) {
     if (!N.history.empty()) std::snprintf(last, sizeof last, "%.3e", N.history.back());
     if (R.coulomb) {
       const CoulombResult& C = R.coulomb_loop;
-      std::printf("Coulomb F = %g: %s after %d Tresca solves, %lld Newton steps in all (reason: %s); changes of phi:",
-                  opt.coulomb, C.converged() ? "converged" : "NOT CONVERGED", C.iterations, C.newton_steps,
-                  to_string(C.reason));
-      for (real c : C.changes) std::printf(" %.1e", c);
-      std::printf("\nthe last Tresca solve (phi_i = F lambda_i of the one before, max |phi_i - F lambda_i| = %.2e N):\n",
-                  R.coulomb_consistency);
+      if (R.coulomb_fallback)
+        std::printf("Coulomb F = %g: the lagged bound did not converge; the fixed point of Tresca solves took over\n",
+                    opt.coulomb);
+      if (opt.coulomb_method == RunOptions::CoulombMethod::lagged && !R.coulomb_fallback) {
+        std::printf("Coulomb F = %g, the bound phi_i = F lambda_i updated at every Newton step; max |phi_i - F lambda_i| = %.2e N\n",
+                    opt.coulomb, R.coulomb_consistency);
+      } else {
+        std::printf("Coulomb F = %g: %s after %d Tresca solves, %lld Newton steps in all (reason: %s); changes of phi:",
+                    opt.coulomb, C.converged() ? "converged" : "NOT CONVERGED", C.iterations, C.newton_steps,
+                    to_string(C.reason));
+        for (real c : C.changes) std::printf(" %.1e", c);
+        std::printf("\nthe last Tresca solve (phi_i = F lambda_i of the one before, max |phi_i - F lambda_i| = %.2e N):\n",
+                    R.coulomb_consistency);
+      }
     }
     std::printf("%s after %d Newton iterations (reason: %s), final |v| %s (eps %.1e)\n",
                 N.converged() ? "converged" : "NOT CONVERGED", N.iterations, to_string(N.reason), last,

@@ -28,9 +28,9 @@ using namespace tresca;
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
   try {
-    Args a(argc, argv, {"--levels", "--threads", "--phi", "--json"}, {"--help", "--no-nested"});
+    Args a(argc, argv, {"--levels", "--threads", "--phi", "--coulomb", "--json"}, {"--help", "--no-nested"});
     if (a.has("--help")) {
-      std::puts("usage: scaling [--levels 4-10] [--threads 1,2] [--phi F] [--no-nested] [--json FILE]");
+      std::puts("usage: scaling [--levels 4-10] [--threads 1,2] [--phi F | --coulomb F] [--no-nested] [--json FILE]");
       return 0;
     }
     const auto levels = parse_level_range(a.str("--levels", "4-10"));
@@ -47,6 +47,8 @@ int main(int argc, char** argv) {
     }
     const double phi = a.real_value("--phi", 1.0);
     const bool nested = !a.has("--no-nested");
+    const double coulomb = a.has("--coulomb") ? a.real_value("--coulomb", 0) : -1;
+    if (a.has("--coulomb") && !(coulomb >= 0)) throw std::invalid_argument("--coulomb " + a.str("--coulomb") + " must be >= 0");
     const std::string json = a.str("--json");
     if (!json.empty()) check_writable(json);
     for (int L : levels) check_memory(spec_for_level(L));
@@ -55,8 +57,9 @@ int main(int argc, char** argv) {
     std::printf("# nested iteration %s; newton, outer, inner, S-app, fmv/step: this mesh; fmv nest: the coarser meshes;\n"
                 "# fmv/solve: all of it (coarser meshes, condensed load, Newton, final check and recovery)\n",
                 nested ? "on" : "off (--no-nested)");
-    std::printf("%5s %3s %10s %8s %8s %8s %8s %8s %8s %6s %6s %6s %6s %8s %8s %9s %8s %6s %8s %7s\n", "level", "thr",
-                "dofs", "nested", "setup", "condense", "solve", "recover", "total", "newton", "outer", "inner", "S-app",
+    if (coulomb >= 0) std::printf("# Coulomb F = %g: fp = fixed-point iterations (Tresca solves), newton = all their steps\n", coulomb);
+    std::printf("%5s %3s %10s %8s %8s %8s %8s %8s %8s %4s %6s %6s %6s %6s %8s %8s %9s %8s %6s %8s %7s\n", "level", "thr",
+                "dofs", "nested", "setup", "condense", "solve", "recover", "total", "fp", "newton", "outer", "inner", "S-app",
                 "fmv/step", "fmv nest", "fmv/solve", "fmv K_ii", "ratio", "peak GB", "speedup");
     bool all_converged = true;
     std::string rows = "[";
@@ -80,12 +83,14 @@ int main(int argc, char** argv) {
         RunOptions o;
         o.recover_interior = true;
         o.nested = nested;
+        o.coulomb = coulomb;
         const RunResult R = run_tresca(s, o);
         if (T == threads.front()) t_first = R.times.total;
         const double speedup = t_first / R.times.total;
-        std::printf("%5d %3d %10lld %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %6d %6lld %6lld %6lld %8.1f %8.1f %9.1f %8.1f %6.1f %8.2f %7.2f %s\n",
+        std::printf("%5d %3d %10lld %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %4d %6d %6lld %6lld %6lld %8.1f %8.1f %9.1f %8.1f %6.1f %8.2f %7.2f %s\n",
                     L, T, (long long)R.problem->free_dofs(), R.times.nested, R.times.setup, R.times.condense,
-                    R.times.solve, R.times.recover, R.times.total, int(R.newton_steps()), R.newton.outer_iterations,
+                    R.times.solve, R.times.recover, R.times.total, R.coulomb ? R.coulomb_loop.iterations : 0,
+                    int(R.newton_steps()), R.newton.outer_iterations,
                     R.inner_iterations, R.newton.operator_applications, R.fine_matvecs_per_newton_step(),
                     R.nested_fine_matvecs, R.fine_matvecs_total, fmv_linear,
                     R.fine_matvecs_total / fmv_linear, R.peak_memory / 1e9, speedup,

@@ -4,6 +4,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <Eigen/Dense>
+
+#include "kernels/vector_ops.hpp"
+
 namespace tresca {
 
 const char* to_string(CoulombReason r) {
@@ -26,6 +30,8 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, const std::vector<re
   // the first solve and the last go to eps; in between, a solve stops at
   // rtol = 0.1 * the last change of phi (the tolerances tighten together)
   real change = INFINITY;
+  std::vector<real> G(p), f(p), G_prev, f_prev;
+  std::vector<std::vector<real>> dF, dG;  // Anderson's differences, oldest first
   for (int m = 0;; ++m) {
     const bool to_eps = m == 0 || change <= co.tol;
     no.rtol = to_eps ? newton.rtol : std::max(newton.rtol, real(0.1) * change);
@@ -41,16 +47,54 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, const std::vector<re
       C.reason = CoulombReason::tresca_failed;
       return C;
     }
-    // phi^{m+1} = F lambda^m and its relative change
+    // G = F lambda^m, the residual f = G - phi^m and its relative size
     real dmax = 0, pmax = 0;
     for (index i = 0; i < p; ++i) {
-      const real next = co.F * std::max(real(0), L.lambda[i]);
-      dmax = std::max(dmax, std::abs(next - law.phi[i]));
-      pmax = std::max(pmax, next);
-      law.phi[i] = next;
+      G[i] = co.F * std::max(real(0), L.lambda[i]);
+      f[i] = G[i] - law.phi[i];
+      dmax = std::max(dmax, std::abs(f[i]));
+      pmax = std::max(pmax, G[i]);
     }
+    const real last_change = change;
     change = pmax > 0 ? dmax / pmax : 0;
     C.changes.push_back(change);
+    // next bound: Anderson's combination of the last steps, phi = G - dG gamma
+    // with gamma minimising |f - dF gamma|, kept >= 0; plain phi = G when
+    // there is no history or the change grew (the history is then dropped)
+    if (co.anderson > 0 && m > 0 && change < last_change) {
+      dF.push_back(f);
+      dG.push_back(G);
+      for (index i = 0; i < p; ++i) {
+        dF.back()[i] -= f_prev[i];
+        dG.back()[i] -= G_prev[i];
+      }
+      if (int(dF.size()) > co.anderson) {
+        dF.erase(dF.begin());
+        dG.erase(dG.begin());
+      }
+    } else {
+      dF.clear();
+      dG.clear();
+    }
+    f_prev = f;
+    G_prev = G;
+    law.phi = G;
+    const int k = int(dF.size());
+    if (k > 0) {
+      Eigen::MatrixXd A(k, k);
+      Eigen::VectorXd rhs(k);
+      for (int a = 0; a < k; ++a) {
+        rhs[a] = dot(p, dF[a].data(), f.data());
+        for (int b = 0; b < k; ++b) A(a, b) = dot(p, dF[a].data(), dF[b].data());
+      }
+      const Eigen::VectorXd gamma = A.ldlt().solve(rhs);
+      if (gamma.allFinite())
+        for (index i = 0; i < p; ++i) {
+          real v = G[i];
+          for (int a = 0; a < k; ++a) v -= gamma[a] * dG[a][i];
+          law.phi[i] = std::max(real(0), v);
+        }
+    }
     // converged: a solve to eps whose lambda reproduces its own bound
     if (to_eps && change <= co.tol) {
       C.reason = CoulombReason::converged;

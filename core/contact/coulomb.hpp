@@ -22,6 +22,7 @@ struct CoulombOptions {
   real F = 0;             // friction coefficient >= 0
   real tol = 1e-6;        // on the relative change of phi
   int max_iterations = 50;
+  int anderson = 2;       // depth of Anderson acceleration (0: the plain fixed point)
 };
 
 enum class CoulombReason { converged, iteration_limit, tresca_failed };

@@ -72,21 +72,33 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.newton.u.assign(3 * p, 0);
     R.newton.lambda.assign(p, 0);
     R.newton.status.assign(p, 0);
+  } else if (opt.coulomb >= 0 && opt.coulomb_method == RunOptions::CoulombMethod::lagged) {
+    R.coulomb = true;
+    NewtonOptions lagged = newton;
+    lagged.coulomb = opt.coulomb;
+    R.newton = semismooth_newton(S, btilde, R.contact, lagged);
+    R.contact.phi = R.newton.phi;
+    R.coulomb_loop.iterations = 1;
+    R.coulomb_loop.reason = R.newton.converged() ? CoulombReason::converged : CoulombReason::tresca_failed;
+    R.coulomb_loop.newton_steps = R.newton.iterations;
+    R.coulomb_loop.inner_iterations = R.newton.inner_iterations;
+    R.coulomb_loop.fine_matvecs = R.newton.fine_matvecs;
   } else if (opt.coulomb >= 0) {
+    R.coulomb = true;
     CoulombOptions co;
     co.F = opt.coulomb;
     co.tol = opt.coulomb_tol;
-    R.coulomb = true;
     R.coulomb_loop = coulomb_fixed_point(S, btilde, R.contact, co, newton);
     R.newton = std::move(R.coulomb_loop.last);
     R.coulomb_loop.last = {};
     R.contact = R.coulomb_loop.law;
-    for (index i = 0; i < R.problem->contact_nodes(); ++i)
-      R.coulomb_consistency = std::max(R.coulomb_consistency,
-                                       std::abs(R.contact.phi[i] - co.F * std::max(real(0), R.newton.lambda[i])));
   } else {
     R.newton = semismooth_newton(S, btilde, R.contact, newton);
   }
+  if (R.coulomb)
+    for (index i = 0; i < R.problem->contact_nodes(); ++i)
+      R.coulomb_consistency = std::max(R.coulomb_consistency,
+                                       std::abs(R.contact.phi[i] - opt.coulomb * std::max(real(0), R.newton.lambda[i])));
   const double t3 = wall_time();
   if (opt.phase_done) opt.phase_done("semismooth* Newton", t3 - t2);
   // the final check's tight S u, warm from E u0 when there is one, also
@@ -112,6 +124,20 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.fine_matvecs_total = R.nested_fine_matvecs + R.newton_fine_matvecs() + S.apply_work(cond.iterations) +
                          S.apply_work(R.report.inner.iterations);
   R.peak_memory = peak_memory_bytes();
+  // the lagged Coulomb bound can oscillate for large F (measured: F = 1.5
+  // on 32x16x16, stick and slip flipping every step); then the whole run
+  // again with the fixed point of Tresca solves, its work and time added
+  if (R.coulomb && opt.coulomb_method == RunOptions::CoulombMethod::lagged && !R.newton.converged() &&
+      (R.newton.reason == NewtonReason::stagnation || R.newton.reason == NewtonReason::iteration_limit)) {
+    RunOptions f = opt;
+    f.coulomb_method = RunOptions::CoulombMethod::fixed_point;
+    if (opt.phase_done) opt.phase_done("Coulomb: the lagged bound did not converge; again by the fixed point", R.times.total);
+    RunResult F = run_tresca(spec, f);
+    F.coulomb_fallback = true;
+    F.fine_matvecs_total += R.fine_matvecs_total;
+    F.times.total += R.times.total;
+    return F;
+  }
   return R;
 }
 

@@ -46,7 +46,12 @@ struct RunOptions {
   // Coulomb friction (coulomb.hpp): coefficient F >= 0 makes the bound
   // phi_i = F lambda_i (contact.phi / spec.phi are then not used); < 0: Tresca
   real coulomb = -1;
-  real coulomb_tol = 1e-6;  // the fixed point's stop on the relative change of phi (coarse meshes: nested_rtol)
+  real coulomb_tol = 1e-6;
+  // how: the bound lagged by one Newton step inside one solve (semismooth.hpp,
+  // NewtonOptions::coulomb; 2x the Tresca work at F = 0.3, 3.6-4x at F = 0.8,
+  // and if it fails, e.g. oscillates for large F, the fixed point takes over),
+  // or a fixed point of whole Tresca solves (coulomb.hpp; 2.8x and 5.6-6.3x)
+  enum class CoulombMethod { lagged, fixed_point } coulomb_method = CoulombMethod::lagged;  // the fixed point's stop on the relative change of phi (coarse meshes: nested_rtol)
 };
 
 struct RunTimes {
@@ -62,6 +67,7 @@ struct RunResult {
   // Coulomb: the fixed point's account (its `last` moved into newton)
   bool coulomb = false;
   CoulombResult coulomb_loop;
+  bool coulomb_fallback = false;  // the lagged bound failed; the fixed point took over
   real coulomb_consistency = 0;  // max_i |phi_i - F lambda_i| at the solution [N]
   bool converged() const { return newton.converged() && (!coulomb || coulomb_loop.converged()); }
   std::string reason() const {

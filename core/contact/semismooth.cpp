@@ -191,8 +191,10 @@ bool stagnated(const std::vector<real>& h, int w) {
   return last > 0.5 * before;
 }
 
-NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
-                               const NewtonOptions& opt) {
+NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde,
+                               const ContactConditions& given, const NewtonOptions& opt) {
+  // Coulomb (opt.coulomb >= 0): the bound follows lambda at every iteration
+  ContactConditions law = given;
   const double t0 = wall_time();
   const index p = S.size() / 3, n3 = 3 * p;
   auto size_error = [&](const char* what, size_t got, index want) {
@@ -221,6 +223,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   R.status.assign(p, 0);
   auto finish = [&](NewtonReason reason) {
     R.reason = reason;
+    R.phi = law.phi;
     R.inner_iterations = work.iterations;
     R.fine_matvecs = work.fine_matvecs;
     return R;
@@ -263,6 +266,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     {
       ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
       for (index i = 0; i < n3; ++i) r[i] = R.Su[i] - btilde[i];
+      if (opt.coulomb >= 0)
+        for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * std::max(real(0), R.lambda[i]);
       vnorm = std::sqrt(approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), r.data(), v.data(), d.data(),
                                            R.status.data()));
     }

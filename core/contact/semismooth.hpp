@@ -88,6 +88,12 @@ struct NewtonOptions {
   // optional, with u0: S u0 itself (3p), e.g. the tracked S u of an earlier
   // solve from which this one continues; then no solve is needed for it
   const std::vector<real>* Su0 = nullptr;
+  // Coulomb with the bound lagged by one step: F >= 0 sets phi_i = F lambda_i
+  // of the current iterate before every approximation step (the law's phi is
+  // then ignored). ||v̂|| with that bound is the Coulomb problem's own
+  // residual, so the stopping rule stays; the Newton step does not
+  // differentiate phi (a quasi-Newton step, still symmetric). < 0: Tresca.
+  real coulomb = -1;
 };
 
 struct NewtonResult {
@@ -96,6 +102,7 @@ struct NewtonResult {
   std::vector<real> history;           // ||v̂|| after each approximation step (first at x0)
   std::vector<real> u, lambda, Su;     // 3p, p, 3p
   std::vector<std::uint8_t> status;    // per node: kContact | kStick at the last approximation step
+  std::vector<real> phi;               // the Tresca bound of the last approximation step
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
   int outer_limit_hits = 0;  // Newton steps whose outer CG stopped at its iteration limit
   // work in fine-grid matvec equivalents, from the solvers' own counts and

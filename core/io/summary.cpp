@@ -38,7 +38,10 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   Json coulomb;
   if (R.coulomb) {
     const CoulombResult& C = R.coulomb_loop;
-    coulomb.num("F", opt.coulomb).integer("fixed_point_iterations", C.iterations)
+    coulomb.num("F", opt.coulomb)
+        .str("method", opt.coulomb_method == RunOptions::CoulombMethod::lagged ? "lagged" : "fixed_point")
+        .boolean("fallback_to_fixed_point", R.coulomb_fallback)
+        .integer("fixed_point_iterations", C.iterations)
         .str("reason", to_string(C.reason)).boolean("converged", C.converged()).array("changes", C.changes)
         .integer("newton_steps", C.newton_steps).num("consistency", R.coulomb_consistency);
   }
