@@ -24,6 +24,11 @@ const char* kHelp =
     "  --level L          mesh level (default 6): ex = ceil(4*2^(L/2)), ey = ez = ceil(2*2^(L/2))\n"
     "  --dims EXxEYxEZ    explicit element counts instead of a level\n"
     "  --phi F            Tresca friction bound per contact node [N] (default 1)\n"
+    "  --obstacle KIND:P  a shaped rigid obstacle instead of the plane (lengths in m; x, y in the\n"
+    "                     box's frame): plane:GAP,SLOPE_X,SLOPE_Y (gap = GAP + SLOPE_X x + SLOPE_Y y),\n"
+    "                     sphere:R,CX,CY,GAP (top GAP below the face at (CX,CY)),\n"
+    "                     cylinder:R,CY,GAP (axis along x at y = CY); excludes --gap\n"
+    "  --load-scale S     multiplies both tractions (default 1)\n"
     "  --coulomb F        Coulomb friction, bound phi_i = F lambda_i per contact node (F >= 0),\n"
     "                     excludes --phi\n"
     "  --coulomb-method lagged|fixed-point  the bound follows lambda at every Newton step of\n"
@@ -81,7 +86,7 @@ int main(int argc, char** argv) {
   try {
     const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb", "--coulomb-method"},
+                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb", "--coulomb-method", "--obstacle", "--load-scale"},
                   {"--quiet", "--help", "--profile", "--no-nested"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);

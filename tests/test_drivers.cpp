@@ -80,6 +80,16 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --dims 4x2x2 --outer-pc ilu", "ilu");
   expect_error("tresca --dims 4x2x2 --gap -0.1", "-0.1");
   expect_error("tresca --dims 4x2x2 --gap nan", "nan");
+  expect_error("tresca --dims 4x2x2 --coulomb -0.1", "-0.1");
+  expect_error("tresca --dims 4x2x2 --coulomb 0.3 --phi 5", "--phi");
+  expect_error("tresca --dims 4x2x2 --coulomb 0.3 --coulomb-method newton", "newton");
+  expect_error("tresca --dims 4x2x2 --obstacle cone:1,2,3", "cone");
+  expect_error("tresca --dims 4x2x2 --obstacle sphere:1,2", "sphere:RADIUS,CX,CY,GAP");
+  expect_error("tresca --dims 4x2x2 --obstacle sphere:-1,1,0.5,0", "radius");
+  expect_error("tresca --dims 4x2x2 --obstacle sphere:1,1,x,0", "'x'");
+  expect_error("tresca --dims 4x2x2 --obstacle plane:0.01,-0.1,0", "cuts into the contact face");
+  expect_error("tresca --dims 4x2x2 --obstacle plane:0,0,0 --gap 0.1", "--gap");
+  expect_error("tresca --dims 4x2x2 --load-scale -2", "-2");
 }
 
 TEST(TrescaDriver, ReportsNonConvergenceInOutputAndExitStatus) {

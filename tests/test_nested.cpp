@@ -83,7 +83,7 @@ TEST(Nested, CoarseConditionsCarryDensities) {
 void nested_equals_cold(real phi, real gap) {
   ProblemSpec spec = spec_for_dims(24, 12, 12);
   spec.phi = phi;
-  spec.gap = gap;
+  spec.obstacle.gap = gap;
   RunOptions o;
   o.recover_interior = false;
   o.nested_min_contact_nodes = 40;

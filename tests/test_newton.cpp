@@ -304,7 +304,7 @@ TEST(SemismoothNewton, GapLargerThanTheFreeDisplacementGivesTheFreeElasticSoluti
   // contact face moves as the unconstrained body does: S u = b̃
   ProblemSpec spec = spec_for_dims(8, 4, 4);
   spec.phi = 0;
-  spec.gap = 10;
+  spec.obstacle.gap = 10;
   RunOptions o;
   o.recover_interior = false;
   const RunResult R = run_tresca(spec, o);

@@ -10,13 +10,21 @@
 
 namespace tresca {
 
+ContactConditions contact_conditions(const Problem& P) {
+  const index p = P.contact_nodes();
+  ContactConditions c = ContactConditions::uniform(p, P.spec.phi, 0);
+  for (index i = 0; i < p; ++i) {
+    const index ix = 1 + i % P.grid.ex, iy = i / P.grid.ex;
+    c.gap[i] = P.spec.obstacle.gap_at(P.grid.x0 + real(ix) * P.grid.hx(), P.grid.y0 + real(iy) * P.grid.hy());
+  }
+  return c;
+}
+
 RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   RunResult R;
   const double t0 = wall_time();
   R.problem = std::make_unique<Problem>(make_problem(spec));
-  R.contact = opt.contact.phi.empty()
-                  ? ContactConditions::uniform(R.problem->contact_nodes(), spec.phi, spec.gap)
-                  : opt.contact;
+  R.contact = opt.contact.phi.empty() ? contact_conditions(*R.problem) : opt.contact;
   // nested iteration: the coarser mesh first (before this mesh's operators
   // exist, so the peak memory stays this mesh's). It hands up (u, lambda)
   // as the Newton initial iterate and, trilinearly interpolated, its K_ii^{-1}

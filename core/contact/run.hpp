@@ -41,7 +41,7 @@ struct RunOptions {
   // compute b̃ and S u to 1e-3 nested_rtol
   real nested_rtol = 1e-4;
   real tight_rtol = 1e-12;
-  // the contact law per node (p values each); empty: spec.phi and spec.gap at every node
+  // the contact law per node (p values each); empty: contact_conditions(problem)
   ContactConditions contact;
   // Coulomb friction (coulomb.hpp): coefficient F >= 0 makes the bound
   // phi_i = F lambda_i (contact.phi / spec.phi are then not used); < 0: Tresca
@@ -92,6 +92,9 @@ struct RunResult {
     return newton_steps() > 0 ? newton_fine_matvecs() / double(newton_steps()) : 0;
   }
 };
+
+// spec.phi at every contact node, and the gap to spec.obstacle under it
+ContactConditions contact_conditions(const Problem& P);
 
 RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt);
 

@@ -38,6 +38,28 @@ ProblemSpec spec_for_dims(index ex, index ey, index ez) {
   return s;
 }
 
+const char* to_string(Obstacle::Kind k) {
+  switch (k) {
+    case Obstacle::Kind::plane: return "plane";
+    case Obstacle::Kind::sphere: return "sphere";
+    case Obstacle::Kind::cylinder: return "cylinder";
+  }
+  return "?";
+}
+
+real Obstacle::gap_at(real x, real y) const {
+  switch (kind) {
+    case Kind::plane: return gap + slope_x * x + slope_y * y;
+    case Kind::sphere:
+    case Kind::cylinder: {
+      const real dx = kind == Kind::sphere ? x - cx : 0, dy = y - cy, r2 = dx * dx + dy * dy;
+      // R - sqrt(R^2 - r^2) without the cancellation near the top
+      return r2 < radius * radius ? gap + r2 / (radius + std::sqrt(radius * radius - r2)) : kNoObstacle;
+    }
+  }
+  return kNoObstacle;
+}
+
 void validate(const ProblemSpec& s) {
   std::ostringstream os;
   if (s.ex < 1 || s.ey < 1 || s.ez < 1) {
@@ -52,8 +74,29 @@ void validate(const ProblemSpec& s) {
     os << "Poisson ratio nu = " << s.nu << " must lie in (-1, 0.5)";
     fail(os.str());
   }
-  if (!(s.gap >= 0) || !std::isfinite(s.gap)) {
-    os << "gap = " << s.gap << " must be >= 0 and finite";
+  const Obstacle& o = s.obstacle;
+  if (!(o.gap >= 0) || !std::isfinite(o.gap)) {
+    os << "gap = " << o.gap << " must be >= 0 and finite";
+    fail(os.str());
+  }
+  if (o.kind != Obstacle::Kind::plane && (!(o.radius > 0) || !std::isfinite(o.radius))) {
+    os << to_string(o.kind) << " radius = " << o.radius << " must be positive and finite";
+    fail(os.str());
+  }
+  if (!std::isfinite(o.slope_x) || !std::isfinite(o.slope_y) || !std::isfinite(o.cx) || !std::isfinite(o.cy)) {
+    os << "obstacle parameters must be finite";
+    fail(os.str());
+  }
+  // a plane is linear: it stays below the contact face iff it does at the corners
+  for (real x : {s.x0, s.x0 + s.lx})
+    for (real y : {s.y0, s.y0 + s.ly})
+      if (!(o.gap_at(x, y) >= 0)) {
+        os << "the obstacle cuts into the contact face: gap " << o.gap_at(x, y) << " m at (x, y) = (" << x << ", " << y
+           << ")";
+        fail(os.str());
+      }
+  if (!(s.load_scale >= 0) || !std::isfinite(s.load_scale)) {
+    os << "load scale = " << s.load_scale << " must be >= 0 and finite";
     fail(os.str());
   }
   if (!(s.phi >= 0) || !std::isfinite(s.phi)) {
@@ -95,7 +138,7 @@ Problem make_problem(const ProblemSpec& spec) {
     for (index ey = 0; ey < g.ey; ++ey)
       for (int k = 0; k < 4; ++k) {
         const index n = g.node(g.ex, ey + (k & 1), ez + (k >> 1));
-        for (int a = 0; a < 3; ++a) P.load[a * N + n] += spec.traction_right[a] * qr;
+        for (int a = 0; a < 3; ++a) P.load[a * N + n] += spec.load_scale * spec.traction_right[a] * qr;
       }
   // top face z = lz: quads in (x,y), area hx*hy
   const real qt = g.hx() * g.hy() / 4;
@@ -103,7 +146,7 @@ Problem make_problem(const ProblemSpec& spec) {
     for (index ex = 0; ex < g.ex; ++ex)
       for (int k = 0; k < 4; ++k) {
         const index n = g.node(ex + (k & 1), ey + (k >> 1), g.ez);
-        for (int a = 0; a < 3; ++a) P.load[a * N + n] += spec.traction_top[a] * qt;
+        for (int a = 0; a < 3; ++a) P.load[a * N + n] += spec.load_scale * spec.traction_top[a] * qt;
       }
   for (index iz = 0; iz < g.nz(); ++iz)
     for (index iy = 0; iy < g.ny(); ++iy)

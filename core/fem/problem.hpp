@@ -21,6 +21,27 @@
 
 namespace tresca {
 
+// The rigid obstacle below the contact face (lengths in metres, x and y in
+// the box's frame). gap_at(x, y) >= 0 is the vertical distance from the
+// contact face to the obstacle under the point (non-penetration
+// u_z + gap >= 0, the normal staying z: small deformations and gentle shapes):
+//   plane:    gap + slope_x x + slope_y y
+//   sphere:   radius R, its top point `gap` below the face at (cx, cy):
+//             gap + R - sqrt(R^2 - rho^2), rho the distance from (cx, cy)
+//   cylinder: axis along x at y = cy, top line `gap` below the face:
+//             gap + R - sqrt(R^2 - (y - cy)^2)
+// Where a sphere or cylinder is not under the point the gap is kNoObstacle.
+struct Obstacle {
+  enum class Kind { plane, sphere, cylinder };
+  Kind kind = Kind::plane;
+  real gap = 0;
+  real slope_x = 0, slope_y = 0;     // plane
+  real radius = 0, cx = 0, cy = 0;   // sphere (cx, cy), cylinder (cy)
+  static constexpr real kNoObstacle = 1e6;
+  real gap_at(real x, real y) const;
+};
+const char* to_string(Obstacle::Kind k);
+
 struct ProblemSpec {
   int level = -1;                  // -1 when dims were given explicitly
   index ex = 0, ey = 0, ez = 0;
@@ -29,8 +50,9 @@ struct ProblemSpec {
   real E = 2.1e9, nu = 0.277;
   std::array<real, 3> traction_right{-5e8, 0, 0};  // on x = x0 + lx
   std::array<real, 3> traction_top{0, 0, -1e8};    // on z = z0 + lz
+  real load_scale = 1;             // multiplies both tractions
   real phi = 1;                    // Tresca bound per contact node (a force)
-  real gap = 0;                    // initial gap to the rigid plane below the contact face [m]
+  Obstacle obstacle;               // the rigid obstacle (default: the plane touching the face)
 
   // sizes follow from the element counts alone (no need to build the problem)
   index nodes() const { return (ex + 1) * (ey + 1) * (ez + 1); }

@@ -67,6 +67,42 @@ long long Args::int_value(const std::string& k, long long def) const {
   return v;
 }
 
+Obstacle parse_obstacle(const std::string& text) {
+  const auto colon = text.find(':');
+  const std::string kind = text.substr(0, colon);
+  std::vector<real> v;
+  if (colon != std::string::npos) {
+    std::istringstream is(text.substr(colon + 1));
+    std::string item;
+    while (std::getline(is, item, ',')) {
+      char* end = nullptr;
+      const double x = std::strtod(item.c_str(), &end);
+      if (item.empty() || *end) fail("--obstacle '" + text + "': '" + item + "' is not a number");
+      v.push_back(x);
+    }
+  }
+  Obstacle o;
+  auto need = [&](size_t n, const char* form) {
+    if (v.size() != n) fail("--obstacle '" + text + "': expected " + form);
+  };
+  if (kind == "plane") {
+    need(3, "plane:GAP,SLOPE_X,SLOPE_Y");
+    o.kind = Obstacle::Kind::plane;
+    o.gap = v[0], o.slope_x = v[1], o.slope_y = v[2];
+  } else if (kind == "sphere") {
+    need(4, "sphere:RADIUS,CX,CY,GAP");
+    o.kind = Obstacle::Kind::sphere;
+    o.radius = v[0], o.cx = v[1], o.cy = v[2], o.gap = v[3];
+  } else if (kind == "cylinder") {
+    need(3, "cylinder:RADIUS,CY,GAP (axis along x)");
+    o.kind = Obstacle::Kind::cylinder;
+    o.radius = v[0], o.cy = v[1], o.gap = v[2];
+  } else {
+    fail("--obstacle '" + text + "': unknown kind '" + kind + "' (plane, sphere or cylinder)");
+  }
+  return o;
+}
+
 ProblemSpec spec_from_args(const Args& a, int default_level) {
   if (a.has("--level") && a.has("--dims")) fail("give either --level or --dims, not both");
   ProblemSpec s;
@@ -86,7 +122,12 @@ ProblemSpec spec_from_args(const Args& a, int default_level) {
   s.E = a.real_value("--E", s.E);
   s.nu = a.real_value("--nu", s.nu);
   s.phi = a.real_value("--phi", s.phi);
-  s.gap = a.real_value("--gap", s.gap);
+  if (a.has("--obstacle")) {
+    if (a.has("--gap")) fail("--gap and --obstacle exclude each other (the obstacle's own gap parameter sets it)");
+    s.obstacle = parse_obstacle(a.str("--obstacle"));
+  }
+  s.obstacle.gap = a.real_value("--gap", s.obstacle.gap);
+  s.load_scale = a.real_value("--load-scale", s.load_scale);
   validate(s);
   check_memory(s);
   return s;

@@ -26,6 +26,8 @@ class Args {
 
 // "--level L" or "--dims AxBxC" (exactly one; default level), plus --E, --nu, --phi.
 ProblemSpec spec_from_args(const Args& a, int default_level);
+// "plane:GAP,SLOPE_X,SLOPE_Y" | "sphere:RADIUS,CX,CY,GAP" | "cylinder:RADIUS,CY,GAP" (problem.hpp: Obstacle)
+Obstacle parse_obstacle(const std::string& text);
 // "A-B" or "A" → inclusive range of levels
 std::vector<int> parse_level_range(const std::string& s);
 // throws if the estimated memory of a run exceeds the machine's physical memory

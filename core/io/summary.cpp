@@ -35,6 +35,15 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
     nested += (nested.size() > 1 ? ", " : "") + n.render();
   }
   nested += "]";
+  Json obstacle;
+  {
+    const Obstacle& o = spec.obstacle;
+    obstacle.str("kind", to_string(o.kind)).num("gap", o.gap);
+    if (o.kind == Obstacle::Kind::plane)
+      obstacle.num("slope_x", o.slope_x).num("slope_y", o.slope_y);
+    else
+      obstacle.num("radius", o.radius).num("cx", o.cx).num("cy", o.cy);
+  }
   Json coulomb;
   if (R.coulomb) {
     const CoulombResult& C = R.coulomb_loop;
@@ -53,7 +62,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j.raw("dims", "[" + std::to_string(spec.ex) + ", " + std::to_string(spec.ey) + ", " + std::to_string(spec.ez) + "]")
       .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
       .str("friction", R.coulomb ? "coulomb" : "tresca")
-      .num("phi", R.coulomb ? NAN : spec.phi).num("gap", spec.gap).num("eps", eps).integer("threads", threads).str("build", build_info())
+      .num("phi", R.coulomb ? NAN : spec.phi).num("gap", spec.obstacle.gap).raw("obstacle", obstacle.render()).num("load_scale", spec.load_scale).num("eps", eps).integer("threads", threads).str("build", build_info())
       .str("mg_precision", to_string(opt.mg.precision)).integer("newton_iterations", N.iterations)
       .boolean("converged", R.converged()).str("reason", R.reason())
       .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())

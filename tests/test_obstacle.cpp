@@ -1,0 +1,79 @@
+// Shaped rigid obstacles (problem.hpp: Obstacle): the gaps they give, the
+// checks on their parameters, and contact where, and as much as, they allow.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/contact/run.hpp"
+
+namespace tresca {
+
+TEST(Obstacle, GapsFollowTheShapes) {
+  Obstacle plane;
+  plane.gap = 0.01;
+  plane.slope_x = 0.02;
+  plane.slope_y = -0.005;
+  EXPECT_DOUBLE_EQ(plane.gap_at(1.5, 0.5), 0.01 + 0.03 - 0.0025);
+  Obstacle sphere;
+  sphere.kind = Obstacle::Kind::sphere;
+  sphere.radius = 2;
+  sphere.cx = 1;
+  sphere.cy = 0.5;
+  sphere.gap = 0.001;
+  EXPECT_DOUBLE_EQ(sphere.gap_at(1, 0.5), 0.001);                              // the top
+  EXPECT_NEAR(sphere.gap_at(1.6, 1.3), 0.001 + 2 - std::sqrt(4 - 1.0), 1e-15);  // rho = 1
+  EXPECT_EQ(sphere.gap_at(3.5, 0.5), Obstacle::kNoObstacle);                   // not under the point
+  Obstacle cyl = sphere;
+  cyl.kind = Obstacle::Kind::cylinder;
+  EXPECT_DOUBLE_EQ(cyl.gap_at(-7, 0.5), 0.001);  // the axis runs along x
+  EXPECT_NEAR(cyl.gap_at(0.3, 1.5), 0.001 + 2 - std::sqrt(3.0), 1e-15);
+}
+
+TEST(Obstacle, ParametersAreChecked) {
+  ProblemSpec s = spec_for_dims(4, 2, 2);
+  s.obstacle.slope_x = -0.01;  // gap 0 at x = 0 falls below the face along x
+  EXPECT_THROW(validate(s), std::invalid_argument);
+  s.obstacle.gap = 0.02;  // 0.02 - 0.01 * 2 = 0 at the far end: touching is allowed
+  EXPECT_NO_THROW(validate(s));
+  s.obstacle = Obstacle{};
+  s.obstacle.kind = Obstacle::Kind::sphere;
+  EXPECT_THROW(validate(s), std::invalid_argument);  // radius 0
+  s.obstacle.radius = 1;
+  EXPECT_NO_THROW(validate(s));
+}
+
+TEST(Obstacle, SphereContactStaysOverTheSphereAndGrowsWithTheLoad) {
+  // a sphere of radius 2 under the middle of the face, touching it: the
+  // contact set is a patch around the top that grows with the load
+  ProblemSpec spec = spec_for_dims(24, 12, 12);
+  spec.phi = 3e6;
+  spec.obstacle.kind = Obstacle::Kind::sphere;
+  spec.obstacle.radius = 2;
+  spec.obstacle.cx = 1.2;
+  spec.obstacle.cy = 0.5;
+  index previous = 0;
+  for (real scale : {0.25, 0.5, 1.0}) {
+    spec.load_scale = scale;
+    RunOptions o;
+    o.recover_interior = false;
+    const RunResult R = run_tresca(spec, o);
+    ASSERT_TRUE(R.converged()) << R.reason();
+    const Problem& P = *R.problem;
+    const index p = P.contact_nodes();
+    real rho_max = 0;
+    for (index i = 0; i < p; ++i)
+      if (R.report.status[i] & kContact) {
+        const real x = real(1 + i % P.grid.ex) * P.grid.hx(), y = real(i / P.grid.ex) * P.grid.hy();
+        rho_max = std::max(rho_max, std::hypot(x - 1.2, y - 0.5));
+        // in contact: the body touches the sphere, u_z = -gap
+        EXPECT_NEAR(R.newton.u[2 * p + i], -R.contact.gap[i], 1e-9) << i;
+      }
+    EXPECT_GT(R.report.active, previous) << "load scale " << scale;
+    EXPECT_GT(R.report.separated, 0);
+    EXPECT_LT(rho_max, 2.0);
+    EXPECT_LT(R.report.uz_violation, 1e-12);
+    previous = R.report.active;
+  }
+}
+
+}  // namespace tresca
