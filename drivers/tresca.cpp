@@ -10,6 +10,7 @@
 
 #include "core/io/cli.hpp"
 #include "core/io/output.hpp"
+#include "core/io/problem_file.hpp"
 #include "core/io/summary.hpp"
 #include "core/util/profile.hpp"
 #include "core/contact/run.hpp"
@@ -21,6 +22,8 @@ namespace {
 
 const char* kHelp =
     "usage: tresca [options]\n"
+    "  --problem FILE     the case from a JSON problem file (drivers/cases/README.md); the\n"
+    "                     options below override it\n"
     "  --level L          mesh level (default 6): ex = ceil(4*2^(L/2)), ey = ez = ceil(2*2^(L/2))\n"
     "  --dims EXxEYxEZ    explicit element counts instead of a level\n"
     "  --phi F            Tresca friction bound per contact node [N] (default 1)\n"
@@ -86,7 +89,7 @@ int main(int argc, char** argv) {
   try {
     const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb", "--coulomb-method", "--obstacle", "--load-scale"},
+                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem"},
                   {"--quiet", "--help", "--profile", "--no-nested"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
@@ -96,7 +99,13 @@ int main(int argc, char** argv) {
     table = a.str("--table");
     if (!table.empty() && (a.has("--level") || a.has("--dims") || a.has("--vtk") || a.has("--contact-csv")))
       throw std::invalid_argument("--table runs its own levels; it takes no --level/--dims/--vtk/--contact-csv");
-    spec = spec_from_args(a, 6);
+    ProblemFile file;
+    if (a.has("--problem")) {
+      if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's problem; it takes no --problem");
+      file = read_problem_file(a.str("--problem"));
+      if (file.coulomb >= 0 && !a.has("--phi")) opt.coulomb = file.coulomb;
+    }
+    spec = spec_from_args(a, 6, a.has("--problem") ? &file.spec : nullptr);
     opt.newton.eps = a.real_value("--eps", 1e-6);
     if (!(opt.newton.eps > 0)) throw std::invalid_argument("--eps " + a.str("--eps") + " must be > 0");
     const long long mn = a.int_value("--max-newton", 50);
@@ -116,16 +125,17 @@ int main(int argc, char** argv) {
     if (prec != "single" && prec != "double")
       throw std::invalid_argument("--mg-precision '" + prec + "' must be single or double");
     opt.mg.precision = prec == "single" ? Precision::single_precision : Precision::double_precision;
+    if (a.has("--phi")) opt.coulomb = -1;  // the command line's Tresca bound over a file's Coulomb
+    const std::string method = a.str("--coulomb-method", "lagged");
+    if (method != "lagged" && method != "fixed-point")
+      throw std::invalid_argument("--coulomb-method '" + method + "' must be lagged or fixed-point");
+    opt.coulomb_method = method == "lagged" ? RunOptions::CoulombMethod::lagged : RunOptions::CoulombMethod::fixed_point;
     if (a.has("--coulomb")) {
       opt.coulomb = a.real_value("--coulomb", 0);
       if (!(opt.coulomb >= 0) || !std::isfinite(opt.coulomb))
         throw std::invalid_argument("--coulomb " + a.str("--coulomb") + " must be a friction coefficient >= 0");
       if (a.has("--phi")) throw std::invalid_argument("--coulomb and --phi exclude each other (Coulomb: phi_i = F lambda_i)");
       if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's Tresca case; it takes no --coulomb");
-      const std::string m = a.str("--coulomb-method", "lagged");
-      if (m != "lagged" && m != "fixed-point")
-        throw std::invalid_argument("--coulomb-method '" + m + "' must be lagged or fixed-point");
-      opt.coulomb_method = m == "lagged" ? RunOptions::CoulombMethod::lagged : RunOptions::CoulombMethod::fixed_point;
     }
     opt.nested = !a.has("--no-nested") && table.empty();  // --table: the paper's cold start
     quiet = a.has("--quiet");
@@ -200,10 +210,15 @@ int main(int argc, char** argv) {
     }
 
     if (!quiet) {
-      std::printf("tresca: mesh %s (level %s), %lld nodes, %lld contact nodes, %lld dofs, phi %g, eps %g, %d threads\n",
+      char friction[64];
+      if (opt.coulomb >= 0)
+        std::snprintf(friction, sizeof friction, "Coulomb F %g", opt.coulomb);
+      else
+        std::snprintf(friction, sizeof friction, "phi %g", spec.phi);
+      std::printf("tresca: mesh %s (level %s), %lld nodes, %lld contact nodes, %lld dofs, %s, obstacle %s, eps %g, %d threads\n",
                   dims_string(spec).c_str(), spec.level >= 0 ? std::to_string(spec.level).c_str() : "-",
-                  (long long)spec.nodes(), (long long)spec.contact_nodes(), (long long)spec.free_dofs(), spec.phi,
-                  opt.newton.eps, threads);
+                  (long long)spec.nodes(), (long long)spec.contact_nodes(), (long long)spec.free_dofs(), friction,
+                  to_string(spec.obstacle.kind), opt.newton.eps, threads);
       std::printf("        estimated peak memory %.2f GB; kernels: %s\n", estimated_memory_bytes(spec) / 1e9,
                   build_info().c_str());
     }

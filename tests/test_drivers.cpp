@@ -92,6 +92,40 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --dims 4x2x2 --load-scale -2", "-2");
 }
 
+TEST(TrescaDriver, RunsTheExampleProblemFile) {
+  // the repository's commented example: one command, JSON + CSV + VTU, and
+  // the JSON says what was solved in the problem file's own schema
+  const std::string dir = ::testing::TempDir();
+  const std::string json = dir + "/case.json", csv = dir + "/case.csv", vtu = dir + "/case.vtu";
+  const CmdResult r = run("tresca --problem " + std::string(TRESCA_SOURCE_DIR) + "/drivers/cases/sphere.json --quiet --json " +
+                          json + " --contact-csv " + csv + " --vtk " + vtu);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("Coulomb F = 0.3"), std::string::npos) << r.out;
+  const std::string j = slurp(json);
+  for (const char* key : {"\"problem\": {", "\"kind\":\"sphere\"", "\"coulomb\":0.3", "\"dims\":[32,16,8]",
+                          "\"body_force\":[0.0,0.0,-77000.0]", "\"friction\": \"coulomb\""})
+    EXPECT_NE(j.find(key), std::string::npos) << key << " in " << j;
+  EXPECT_FALSE(slurp(csv).empty());
+  EXPECT_FALSE(slurp(vtu).empty());
+  // the command line overrides the file
+  const CmdResult o = run("tresca --problem " + std::string(TRESCA_SOURCE_DIR) +
+                          "/drivers/cases/sphere.json --dims 16x8x4 --phi 1e4 --quiet --max-newton 30");
+  EXPECT_EQ(o.status, 0) << o.out;
+  EXPECT_EQ(o.out.find("Coulomb"), std::string::npos) << o.out;
+}
+
+TEST(TrescaDriver, RejectsBadProblemFiles) {
+  const std::string dir = ::testing::TempDir();
+  const std::string bad = dir + "/bad.json";
+  {
+    std::ofstream f(bad);
+    f << "{\"loads\": {\"traction\": {\"x0\": [1, 0, 0]}}}";
+  }
+  expect_error("tresca --problem " + bad, "loads.traction.x0");
+  expect_error("tresca --problem " + dir + "/missing.json", "cannot read problem file");
+  expect_error("tresca --problem " + bad + " --table 1-2", "--table");
+}
+
 TEST(TrescaDriver, ReportsNonConvergenceInOutputAndExitStatus) {
   const CmdResult r = run("tresca --dims 8x4x4 --max-newton 1 --quiet");
   EXPECT_EQ(r.status, 1);

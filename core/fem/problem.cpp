@@ -38,6 +38,11 @@ ProblemSpec spec_for_dims(index ex, index ey, index ez) {
   return s;
 }
 
+const char* load_face_name(int f) {
+  static const char* names[kLoadFaces] = {"x1", "y0", "y1", "z1"};
+  return f >= 0 && f < kLoadFaces ? names[f] : "?";
+}
+
 const char* to_string(Obstacle::Kind k) {
   switch (k) {
     case Obstacle::Kind::plane: return "plane";
@@ -95,6 +100,17 @@ void validate(const ProblemSpec& s) {
            << ")";
         fail(os.str());
       }
+  for (int f = 0; f < kLoadFaces; ++f)
+    for (real t : s.traction[f])
+      if (!std::isfinite(t)) {
+        os << "traction on face " << load_face_name(f) << " must be finite";
+        fail(os.str());
+      }
+  for (real b : s.body_force)
+    if (!std::isfinite(b)) {
+      os << "body force must be finite";
+      fail(os.str());
+    }
   if (!(s.load_scale >= 0) || !std::isfinite(s.load_scale)) {
     os << "load scale = " << s.load_scale << " must be >= 0 and finite";
     fail(os.str());
@@ -132,22 +148,31 @@ Problem make_problem(const ProblemSpec& spec) {
   g.z0 = spec.z0;
   const index N = g.nodes();
   P.load.assign(3 * N, 0.0);
-  // right face x = lx: quads in (y,z), area hy*hz
-  const real qr = g.hy() * g.hz() / 4;
-  for (index ez = 0; ez < g.ez; ++ez)
-    for (index ey = 0; ey < g.ey; ++ey)
-      for (int k = 0; k < 4; ++k) {
-        const index n = g.node(g.ex, ey + (k & 1), ez + (k >> 1));
-        for (int a = 0; a < 3; ++a) P.load[a * N + n] += spec.load_scale * spec.traction_right[a] * qr;
-      }
-  // top face z = lz: quads in (x,y), area hx*hy
-  const real qt = g.hx() * g.hy() / 4;
-  for (index ey = 0; ey < g.ey; ++ey)
-    for (index ex = 0; ex < g.ex; ++ex)
-      for (int k = 0; k < 4; ++k) {
-        const index n = g.node(ex + (k & 1), ey + (k >> 1), g.ez);
-        for (int a = 0; a < 3; ++a) P.load[a * N + n] += spec.load_scale * spec.traction_top[a] * qt;
-      }
+  // surface tractions: face f's quads, each node of a quad gets area/4
+  const real L = spec.load_scale;
+  auto face = [&](int f, index n1, index n2, real area, auto node) {
+    for (index j = 0; j < n2; ++j)
+      for (index i = 0; i < n1; ++i)
+        for (int k = 0; k < 4; ++k) {
+          const index n = node(i + (k & 1), j + (k >> 1));
+          for (int a = 0; a < 3; ++a) P.load[a * N + n] += L * spec.traction[f][a] * area / 4;
+        }
+  };
+  face(kLoadX1, g.ey, g.ez, g.hy() * g.hz(), [&](index j, index k) { return g.node(g.ex, j, k); });
+  face(kLoadY0, g.ex, g.ez, g.hx() * g.hz(), [&](index i, index k) { return g.node(i, 0, k); });
+  face(kLoadY1, g.ex, g.ez, g.hx() * g.hz(), [&](index i, index k) { return g.node(i, g.ey, k); });
+  face(kLoadZ1, g.ex, g.ey, g.hx() * g.hy(), [&](index i, index j) { return g.node(i, j, g.ez); });
+  // body force: each brick gives volume/8 to each of its 8 nodes
+  if (spec.body_force != std::array<real, 3>{0, 0, 0}) {
+    const real q = g.hx() * g.hy() * g.hz() / 8;
+    for (index ez = 0; ez < g.ez; ++ez)
+      for (index ey = 0; ey < g.ey; ++ey)
+        for (index ex = 0; ex < g.ex; ++ex)
+          for (int k = 0; k < 8; ++k) {
+            const index n = g.node(ex + (k & 1), ey + ((k >> 1) & 1), ez + (k >> 2));
+            for (int a = 0; a < 3; ++a) P.load[a * N + n] += L * spec.body_force[a] * q;
+          }
+  }
   for (index iz = 0; iz < g.nz(); ++iz)
     for (index iy = 0; iy < g.ny(); ++iy)
       for (int a = 0; a < 3; ++a) P.load[a * N + g.node(0, iy, iz)] = 0;

@@ -42,15 +42,23 @@ struct Obstacle {
 };
 const char* to_string(Obstacle::Kind k);
 
+// faces that can carry a traction, in ProblemSpec::traction order
+enum LoadFace { kLoadX1, kLoadY0, kLoadY1, kLoadZ1, kLoadFaces };
+const char* load_face_name(int f);  // "x1", "y0", "y1", "z1"
+
 struct ProblemSpec {
   int level = -1;                  // -1 when dims were given explicitly
   index ex = 0, ey = 0, ez = 0;
   real lx = 2, ly = 1, lz = 0.9;   // box edges
   real x0 = 0, y0 = 0, z0 = 0.1;   // box origin
   real E = 2.1e9, nu = 0.277;
-  std::array<real, 3> traction_right{-5e8, 0, 0};  // on x = x0 + lx
-  std::array<real, 3> traction_top{0, 0, -1e8};    // on z = z0 + lz
-  real load_scale = 1;             // multiplies both tractions
+  // surface tractions [Pa] on the faces free to carry them (x = x0 is
+  // clamped, z = z0 is the contact face), a body force [N/m^3], all times
+  // load_scale; consistent nodal loads (a quad gives traction * area / 4 to
+  // each of its nodes, a brick body_force * volume / 8)
+  std::array<std::array<real, 3>, kLoadFaces> traction{{{-5e8, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, -1e8}}};
+  std::array<real, 3> body_force{0, 0, 0};
+  real load_scale = 1;
   real phi = 1;                    // Tresca bound per contact node (a force)
   Obstacle obstacle;               // the rigid obstacle (default: the plane touching the face)
 

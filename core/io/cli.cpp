@@ -103,9 +103,9 @@ Obstacle parse_obstacle(const std::string& text) {
   return o;
 }
 
-ProblemSpec spec_from_args(const Args& a, int default_level) {
+ProblemSpec spec_from_args(const Args& a, int default_level, const ProblemSpec* base) {
   if (a.has("--level") && a.has("--dims")) fail("give either --level or --dims, not both");
-  ProblemSpec s;
+  ProblemSpec s = base ? *base : ProblemSpec{};
   if (a.has("--dims")) {
     const std::string d = a.str("--dims");
     long long e[3];
@@ -115,9 +115,11 @@ ProblemSpec spec_from_args(const Args& a, int default_level) {
         d.find_first_not_of("0123456789x") != std::string::npos)
       fail("--dims '" + d + "' is malformed (expected EXxEYxEZ, e.g. 16x8x8)");
     if (e[0] < 1 || e[1] < 1 || e[2] < 1) fail("--dims '" + d + "': every element count must be >= 1");
-    s = spec_for_dims(e[0], e[1], e[2]);
-  } else {
-    s = spec_for_level(a.int_value("--level", default_level));
+    const ProblemSpec m = spec_for_dims(e[0], e[1], e[2]);
+    s.level = m.level, s.ex = m.ex, s.ey = m.ey, s.ez = m.ez;
+  } else if (a.has("--level") || !base || base->ex < 1) {
+    const ProblemSpec d = spec_for_level(a.int_value("--level", default_level));
+    s.level = d.level, s.ex = d.ex, s.ey = d.ey, s.ez = d.ez;
   }
   s.E = a.real_value("--E", s.E);
   s.nu = a.real_value("--nu", s.nu);

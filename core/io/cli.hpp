@@ -25,7 +25,10 @@ class Args {
 };
 
 // "--level L" or "--dims AxBxC" (exactly one; default level), plus --E, --nu, --phi.
-ProblemSpec spec_from_args(const Args& a, int default_level);
+// the problem from the command line, over `base` (a problem file's) when
+// given: --level/--dims, --E, --nu, --phi, --gap, --obstacle, --load-scale
+// override it; without a mesh in either, default_level
+ProblemSpec spec_from_args(const Args& a, int default_level, const ProblemSpec* base = nullptr);
 // "plane:GAP,SLOPE_X,SLOPE_Y" | "sphere:RADIUS,CX,CY,GAP" | "cylinder:RADIUS,CY,GAP" (problem.hpp: Obstacle)
 Obstacle parse_obstacle(const std::string& text);
 // "A-B" or "A" → inclusive range of levels

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/io/output.hpp"
+#include "core/io/problem_file.hpp"
 #include "kernels/simd.hpp"
 
 namespace tresca {
@@ -68,7 +69,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
       .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())
       .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
       .raw("times", times.render()).raw("counts", counts.render()).raw("contact", contact.render())
-      .raw("kkt", kkt.render()).raw("nested", nested).raw("coulomb", R.coulomb ? coulomb.render() : "null").num("peak_memory_bytes", R.peak_memory);
+      .raw("kkt", kkt.render()).raw("problem", problem_json(spec, R.coulomb ? opt.coulomb : -1)).raw("nested", nested).raw("coulomb", R.coulomb ? coulomb.render() : "null").num("peak_memory_bytes", R.peak_memory);
   return j;
 }
 

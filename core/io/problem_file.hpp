@@ -1,0 +1,41 @@
+// The user's own case in a JSON file (--problem case.json): every key is
+// optional, and what is left out is the seed benchmark. // comments are
+// allowed. Schema (drivers/cases/README.md, with a commented example):
+//
+//   "mesh":     {"level": L} or {"dims": [EX, EY, EZ]}
+//   "box":      {"lengths": [LX, LY, LZ], "origin": [X0, Y0, Z0]}      [m]
+//   "material": {"E": E, "nu": NU}                                     [Pa, -]
+//   "loads":    {"traction": {"x1"|"y0"|"y1"|"z1": [TX, TY, TZ], ...},  [Pa]
+//                "body_force": [BX, BY, BZ], "scale": S}                [N/m^3, -]
+//               (with "traction", the faces not listed carry none; x = x0
+//               is clamped and z = z0 is the contact face)
+//   "friction": {"tresca": PHI} or {"coulomb": F}                      [N per node, -]
+//   "obstacle": {"kind": "plane", "gap": G, "slope": [SX, SY]}
+//               {"kind": "sphere", "radius": R, "center": [CX, CY], "gap": G}
+//               {"kind": "cylinder", "radius": R, "y": CY, "gap": G}    [m]
+//
+// Every error is one line naming the file and the key: unknown keys (a
+// typo must not silently leave a default), wrong types, bad values (the
+// problem's own checks, problem.hpp: validate), unreadable or malformed
+// files. The run summary repeats the problem in this same schema, so a
+// result file can be run again as a problem file.
+#pragma once
+#include <string>
+
+#include "core/fem/problem.hpp"
+
+namespace tresca {
+
+struct ProblemFile {
+  ProblemSpec spec;
+  bool mesh_given = false;  // "mesh" present
+  real coulomb = -1;        // >= 0: Coulomb friction with this coefficient
+};
+
+// throws std::invalid_argument with a one-line message
+ProblemFile read_problem_file(const std::string& path);
+ProblemFile parse_problem(const std::string& text, const std::string& origin = "problem");
+// the problem in the file's schema, as JSON text (one line)
+std::string problem_json(const ProblemSpec& s, real coulomb);
+
+}  // namespace tresca

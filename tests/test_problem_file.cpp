@@ -1,0 +1,129 @@
+// Problem files (core/io/problem_file.hpp): defaults, every key read back,
+// the loads they give, and one-line errors that name the key.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+#include "core/io/problem_file.hpp"
+
+namespace tresca {
+
+namespace {
+// the error message of parsing `text`, or "" if it parses
+std::string error_of(const std::string& text) {
+  try {
+    parse_problem(text, "case.json");
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(ProblemFile, EmptyFileIsTheSeedBenchmark) {
+  const ProblemFile f = parse_problem("// nothing but a comment\n{}");
+  const ProblemSpec d;
+  EXPECT_FALSE(f.mesh_given);
+  EXPECT_LT(f.coulomb, 0);
+  EXPECT_EQ(f.spec.E, d.E);
+  EXPECT_EQ(f.spec.phi, d.phi);
+  EXPECT_EQ(f.spec.traction, d.traction);
+  EXPECT_EQ(f.spec.lz, d.lz);
+}
+
+TEST(ProblemFile, EveryKeyIsReadAndWrittenBackTheSame) {
+  ProblemSpec s = spec_for_dims(7, 5, 3);
+  s.lx = 1.5, s.ly = 0.7, s.lz = 0.3, s.x0 = -1, s.y0 = 2, s.z0 = 0.05;
+  s.E = 7e10, s.nu = 0.33;
+  s.traction = {{{1e6, 2e6, 3e6}, {0, 0, 0}, {4e5, 0, -1}, {0, 0, -2e7}}};
+  s.body_force = {0, 1e3, -7.7e4};
+  s.load_scale = 0.75;
+  s.obstacle.kind = Obstacle::Kind::sphere;
+  s.obstacle.radius = 3, s.obstacle.cx = -0.2, s.obstacle.cy = 2.3, s.obstacle.gap = 0.01;
+  const ProblemFile f = parse_problem(problem_json(s, 0.4));
+  const ProblemSpec& r = f.spec;
+  EXPECT_TRUE(f.mesh_given);
+  EXPECT_EQ(f.coulomb, 0.4);
+  EXPECT_EQ(r.ex, 7);
+  EXPECT_EQ(r.ey, 5);
+  EXPECT_EQ(r.ez, 3);
+  EXPECT_EQ(r.lx, 1.5);
+  EXPECT_EQ(r.y0, 2);
+  EXPECT_EQ(r.z0, 0.05);
+  EXPECT_EQ(r.E, 7e10);
+  EXPECT_EQ(r.nu, 0.33);
+  EXPECT_EQ(r.traction, s.traction);
+  EXPECT_EQ(r.body_force, s.body_force);
+  EXPECT_EQ(r.load_scale, 0.75);
+  EXPECT_EQ(r.obstacle.kind, Obstacle::Kind::sphere);
+  EXPECT_EQ(r.obstacle.radius, 3);
+  EXPECT_EQ(r.obstacle.cx, -0.2);
+  EXPECT_EQ(r.obstacle.cy, 2.3);
+  EXPECT_EQ(r.obstacle.gap, 0.01);
+  // and a Tresca bound, a cylinder and a tilted plane
+  s.phi = 5e5;
+  s.obstacle = Obstacle{};
+  s.obstacle.kind = Obstacle::Kind::cylinder, s.obstacle.radius = 1, s.obstacle.cy = 2.4;
+  ProblemFile g = parse_problem(problem_json(s, -1));
+  EXPECT_LT(g.coulomb, 0);
+  EXPECT_EQ(g.spec.phi, 5e5);
+  EXPECT_EQ(g.spec.obstacle.kind, Obstacle::Kind::cylinder);
+  EXPECT_EQ(g.spec.obstacle.cy, 2.4);
+  s.obstacle = Obstacle{};
+  s.obstacle.gap = 0.1, s.obstacle.slope_x = 0.01, s.obstacle.slope_y = -0.02;
+  g = parse_problem(problem_json(s, -1));
+  EXPECT_EQ(g.spec.obstacle.kind, Obstacle::Kind::plane);
+  EXPECT_EQ(g.spec.obstacle.slope_y, -0.02);
+}
+
+TEST(ProblemFile, LoadsAreConsistentNodalForces) {
+  // a traction on y = y0 and a body force: the nodal loads add up to
+  // traction x area and force x volume, less the shares of the clamped
+  // x = x0 nodes (half of the first layer of elements along x)
+  const ProblemFile f = parse_problem(R"({"mesh": {"dims": [4, 3, 2]}, "box": {"lengths": [2, 1, 0.5]},
+      "loads": {"traction": {"y0": [0, 3e6, 0]}, "body_force": [0, 0, -8e4], "scale": 0.5}})");
+  const Problem P = make_problem(f.spec);
+  const index N = P.nodes();
+  const real keep = 1 - 0.5 / 4;
+  const real fy = std::accumulate(P.load.begin() + N, P.load.begin() + 2 * N, 0.0);
+  const real fz = std::accumulate(P.load.begin() + 2 * N, P.load.end(), 0.0);
+  EXPECT_NEAR(fy, 0.5 * 3e6 * 2 * 0.5 * keep, 1e-6);
+  EXPECT_NEAR(fz, 0.5 * -8e4 * 2 * 1 * 0.5 * keep, 1e-6);
+  EXPECT_EQ(std::accumulate(P.load.begin(), P.load.begin() + N, 0.0), 0.0);  // no x1 traction: "traction" replaces all
+}
+
+TEST(ProblemFile, ErrorsNameTheKey) {
+  EXPECT_NE(error_of(R"({"materail": {}})").find("'materail' is not a known key"), std::string::npos);
+  EXPECT_NE(error_of(R"({"material": {"E": "steel"}})").find("'material.E' must be a number"), std::string::npos);
+  EXPECT_NE(error_of(R"({"material": {"nu": 0.7}})").find("nu"), std::string::npos);
+  EXPECT_NE(error_of(R"({"box": {"lengths": [1, -2, 1]}})").find("'box.lengths' must be positive"), std::string::npos);
+  EXPECT_NE(error_of(R"({"box": {"lengths": [1, 2]}})").find("array of 3 numbers"), std::string::npos);
+  EXPECT_NE(error_of(R"({"mesh": {"dims": [4, 0, 2]}})").find("'mesh.dims[1]' must be >= 1"), std::string::npos);
+  EXPECT_NE(error_of(R"({"mesh": {"dims": [4, 2.5, 2]}})").find("'mesh.dims[1]' must be an integer"), std::string::npos);
+  EXPECT_NE(error_of(R"({"mesh": {"level": 4, "dims": [4, 2, 2]}})").find("exactly one"), std::string::npos);
+  EXPECT_NE(error_of(R"({"mesh": {"level": 99}})").find("mesh.level"), std::string::npos);
+  EXPECT_NE(error_of(R"({"loads": {"traction": {"x0": [1, 0, 0]}}})").find("'loads.traction.x0' is not a known key"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"friction": {"coulomb": -0.1}})").find("'friction.coulomb' must be >= 0"), std::string::npos);
+  EXPECT_NE(error_of(R"({"friction": {}})").find("exactly one"), std::string::npos);
+  EXPECT_NE(error_of(R"({"obstacle": {"kind": "cone"}})").find("'cone' is not"), std::string::npos);
+  EXPECT_NE(error_of(R"({"obstacle": {"kind": "sphere", "radius": 1}})").find("needs 'radius' and 'center'"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"obstacle": {"kind": "plane", "slope": [-0.1, 0]}})").find("cuts into the contact face"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"mesh": {"level": 4},})").find("is not valid JSON"), std::string::npos);
+  EXPECT_EQ(error_of(R"({"mesh": {"level": 4}})"), "");
+  for (const std::string& e : {error_of(R"({"materail": {}})"), error_of("[1, 2]")}) {
+    EXPECT_EQ(e.rfind("case.json: ", 0), 0u) << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
+  try {
+    read_problem_file("/nonexistent/case.json");
+    ADD_FAILURE() << "no error for an unreadable file";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot read problem file '/nonexistent/case.json'"), std::string::npos);
+  }
+}
+
+}  // namespace tresca
