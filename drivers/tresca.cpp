@@ -31,7 +31,9 @@ const char* kHelp =
     "                     box's frame): plane:GAP,SLOPE_X,SLOPE_Y (gap = GAP + SLOPE_X x + SLOPE_Y y),\n"
     "                     sphere:R,CX,CY,GAP (top GAP below the face at (CX,CY)),\n"
     "                     cylinder:R,CY,GAP (axis along x at y = CY); excludes --gap\n"
-    "  --load-scale S     multiplies both tractions (default 1)\n"
+    "  --gap-file F.csv   the gap per contact node from a CSV file ix,iy,gap (every contact\n"
+    "                     node 1 <= ix <= ex, 0 <= iy <= ey once); excludes --gap, --obstacle\n"
+    "  --load-scale S     multiplies all loads (default 1)\n"
     "  --coulomb F        Coulomb friction, bound phi_i = F lambda_i per contact node (F >= 0),\n"
     "                     excludes --phi\n"
     "  --coulomb-method lagged|fixed-point  the bound follows lambda at every Newton step of\n"
@@ -89,7 +91,7 @@ int main(int argc, char** argv) {
   try {
     const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem"},
+                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem", "--gap-file"},
                   {"--quiet", "--help", "--profile", "--no-nested"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
@@ -106,6 +108,14 @@ int main(int argc, char** argv) {
       if (file.coulomb >= 0 && !a.has("--phi")) opt.coulomb = file.coulomb;
     }
     spec = spec_from_args(a, 6, a.has("--problem") ? &file.spec : nullptr);
+    if (a.has("--gap-file")) {
+      if (a.has("--gap") || a.has("--obstacle"))
+        throw std::invalid_argument("--gap-file excludes --gap and --obstacle");
+      if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's problem; it takes no --gap-file");
+      const Problem P = make_problem(spec);
+      opt.contact = contact_conditions(P);
+      opt.contact.gap = read_gap_csv(a.str("--gap-file"), P);
+    }
     opt.newton.eps = a.real_value("--eps", 1e-6);
     if (!(opt.newton.eps > 0)) throw std::invalid_argument("--eps " + a.str("--eps") + " must be > 0");
     const long long mn = a.int_value("--max-newton", 50);
@@ -267,7 +277,7 @@ int main(int argc, char** argv) {
     if (profile) std::printf("\nkernel profile (%s, %d threads)\n%s", build_info().c_str(), threads,
                              profile_table(R.times.total).c_str());
     try {
-      const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.contact.phi};
+      const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.contact.phi, &R.contact.gap};
       if (!json_path.empty()) write_file_atomic(json_path, run_summary(spec, R, threads, opt).render() + "\n");
       if (!csv_path.empty()) write_contact_csv(csv_path, *R.problem, cf);
       if (!vtk_path.empty()) {

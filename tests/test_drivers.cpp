@@ -159,7 +159,7 @@ TEST(TrescaDriver, WritesJsonCsvAndVtk) {
     EXPECT_NE(j.find(key), std::string::npos) << key << " in " << j;
   EXPECT_EQ(j.find("\"eps\": 0,"), std::string::npos) << "eps must be the tolerance used";
   const std::string c = slurp(csv);
-  EXPECT_EQ(c.rfind("ix,iy,x,y,ux,uy,uz,lambda,phi,contact,stick\n", 0), 0u);
+  EXPECT_EQ(c.rfind("ix,iy,x,y,ux,uy,uz,lambda,phi,gap,contact,stick\n", 0), 0u);
   EXPECT_EQ(std::count(c.begin(), c.end(), '\n'), 1 + 24);
   const std::string v = slurp(vtu), vc = slurp(dir + "t_out_contact.vtu");
   EXPECT_NE(v.find("NumberOfPoints=\"84\" NumberOfCells=\"36\""), std::string::npos);

@@ -54,7 +54,8 @@ class OutputFiles : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     spec_ = new ProblemSpec(spec_for_dims(12, 6, 6));
-    spec_->phi = 3e6;  // 56 in contact, 28 separated, 9 sticking, 75 sliding
+    spec_->phi = 3e6;
+    spec_->obstacle.slope_x = 1e-3;  // a gap per node (0 to 2 mm along x), so the CSV's gap column is tested
     RunOptions o;
     R_ = new RunResult(run_tresca(*spec_, o));
   }
@@ -63,7 +64,7 @@ class OutputFiles : public ::testing::Test {
     delete spec_;
   }
   ContactFields fields() const {
-    return {&R_->newton.u, &R_->newton.lambda, &R_->report.r, &R_->report.status, &R_->contact.phi};
+    return {&R_->newton.u, &R_->newton.lambda, &R_->report.r, &R_->report.status, &R_->contact.phi, &R_->contact.gap};
   }
   static ProblemSpec* spec_;
   static RunResult* R_;
@@ -86,17 +87,17 @@ TEST_F(OutputFiles, ContactCsvRowsAreTheSolversValues) {
   std::istringstream is(slurp(path));
   std::string line;
   std::getline(is, line);
-  EXPECT_EQ(line, "ix,iy,x,y,ux,uy,uz,lambda,phi,contact,stick");
+  EXPECT_EQ(line, "ix,iy,x,y,ux,uy,uz,lambda,phi,gap,contact,stick");
   const Problem& P = *R_->problem;
   const index p = P.contact_nodes();
   const auto &u = R_->newton.u, &lam = R_->newton.lambda;
   const auto& st = R_->report.status;
   index rows = 0;
   while (std::getline(is, line)) {
-    double v[11];
-    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", v, v + 1, v + 2, v + 3, v + 4,
-                          v + 5, v + 6, v + 7, v + 8, v + 9, v + 10),
-              11)
+    double v[12];
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", v, v + 1, v + 2, v + 3, v + 4,
+                          v + 5, v + 6, v + 7, v + 8, v + 9, v + 10, v + 11),
+              12)
         << line;
     const index i = rows++;
     ASSERT_LT(i, p);
@@ -111,8 +112,9 @@ TEST_F(OutputFiles, ContactCsvRowsAreTheSolversValues) {
     EXPECT_EQ(v[6], u[2 * p + i]) << "u_z of node " << i;
     EXPECT_EQ(v[7], lam[i]);
     EXPECT_EQ(v[8], R_->contact.phi[i]);
-    EXPECT_EQ(v[9], (st[i] & kContact) ? 1 : 0);
-    EXPECT_EQ(v[10], (st[i] & kStick) ? 1 : 0);
+    EXPECT_EQ(v[9], R_->contact.gap[i]);
+    EXPECT_EQ(v[10], (st[i] & kContact) ? 1 : 0);
+    EXPECT_EQ(v[11], (st[i] & kStick) ? 1 : 0);
   }
   EXPECT_EQ(rows, p);
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <numeric>
 
 #include "core/io/problem_file.hpp"
@@ -124,6 +125,37 @@ TEST(ProblemFile, ErrorsNameTheKey) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("cannot read problem file '/nonexistent/case.json'"), std::string::npos);
   }
+}
+
+TEST(GapFile, ReadsEveryContactNodeAndRejectsTheRest) {
+  const Problem P = make_problem(spec_for_dims(3, 2, 2));  // contact nodes ix 1..3, iy 0..2
+  const std::string path = ::testing::TempDir() + "/gaps.csv";
+  auto write = [&](const std::string& body) {
+    std::ofstream f(path);
+    f << body;
+  };
+  std::string good = "ix,iy,gap\n";
+  for (int iy = 0; iy <= 2; ++iy)
+    for (int ix = 1; ix <= 3; ++ix) good += std::to_string(ix) + "," + std::to_string(iy) + "," + std::to_string(0.01 * ix + 0.1 * iy) + "\n";
+  write(good);
+  const std::vector<real> g = read_gap_csv(path, P);
+  ASSERT_EQ(index(g.size()), P.contact_nodes());
+  for (index c = 0; c < P.contact_nodes(); ++c) EXPECT_NEAR(g[c], 0.01 * (1 + c % 3) + 0.1 * (c / 3), 1e-12) << c;
+  auto error = [&](const std::string& body) -> std::string {
+    write(body);
+    try {
+      read_gap_csv(path, P);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(error("x,y,gap\n").find("header"), std::string::npos);
+  EXPECT_NE(error("ix,iy,gap\n0,0,0.1\n").find("line 2: node (0, 0) is not a contact node"), std::string::npos);
+  EXPECT_NE(error("ix,iy,gap\n1,0,-0.1\n").find("must be >= 0"), std::string::npos);
+  EXPECT_NE(error("ix,iy,gap\n1,0,0.1\n1,0,0.2\n").find("line 3: node (1, 0) is given twice"), std::string::npos);
+  EXPECT_NE(error("ix,iy,gap\n1,0,0.1\n").find("gives 1 of the 9 contact nodes"), std::string::npos);
+  EXPECT_NE(error("ix,iy,gap\n1;0;0.1\n").find("is not ix,iy,gap"), std::string::npos);
 }
 
 }  // namespace tresca

@@ -104,13 +104,13 @@ void write_contact_csv(const std::string& path, const Problem& P, const ContactF
   FilePtr f = open_tmp(path);
   const index p = P.contact_nodes();
   const GridDims& g = P.grid;
-  std::fprintf(f.get(), "ix,iy,x,y,ux,uy,uz,lambda,phi,contact,stick\n");
+  std::fprintf(f.get(), "ix,iy,x,y,ux,uy,uz,lambda,phi,gap,contact,stick\n");
   for (index i = 0; i < p; ++i) {
     const index ix = 1 + i % g.ex, iy = i / g.ex;
     const std::uint8_t s = (*c.status)[i];
-    std::fprintf(f.get(), "%lld,%lld,%.10g,%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%d,%d\n", (long long)ix, (long long)iy,
-                 g.x0 + ix * g.hx(), g.y0 + iy * g.hy(), (*c.u)[i], (*c.u)[p + i], (*c.u)[2 * p + i],
-                 (*c.lambda)[i], (*c.phi)[i], (s & kContact) ? 1 : 0, (s & kStick) ? 1 : 0);
+    std::fprintf(f.get(), "%lld,%lld,%.10g,%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d,%d\n", (long long)ix,
+                 (long long)iy, g.x0 + ix * g.hx(), g.y0 + iy * g.hy(), (*c.u)[i], (*c.u)[p + i], (*c.u)[2 * p + i],
+                 (*c.lambda)[i], (*c.phi)[i], (*c.gap)[i], (s & kContact) ? 1 : 0, (s & kStick) ? 1 : 0);
   }
   commit(std::move(f), path);
 }

@@ -37,6 +37,7 @@ struct ContactFields {
   const std::vector<real>* r;       // 3p contact forces (r_τ, r_z)
   const std::vector<std::uint8_t>* status;
   const std::vector<real>* phi;     // p: Tresca bound per node
+  const std::vector<real>* gap;     // p: gap to the obstacle per node
 };
 
 void write_contact_csv(const std::string& path, const Problem& P, const ContactFields& c);

@@ -1,5 +1,6 @@
 #include "core/io/problem_file.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -177,6 +178,42 @@ ProblemFile read_problem_file(const std::string& path) {
   os << in.rdbuf();
   if (in.bad()) throw std::invalid_argument("cannot read problem file '" + path + "'");
   return parse_problem(os.str(), "problem file '" + path + "'");
+}
+
+std::vector<real> read_gap_csv(const std::string& path, const Problem& P) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("cannot read gap file '" + path + "'");
+  auto fail = [&](long line, const std::string& what) {
+    throw std::invalid_argument("gap file '" + path + "' line " + std::to_string(line) + ": " + what);
+  };
+  std::string row;
+  long line = 1;
+  if (!std::getline(in, row) || row.substr(0, 9) != "ix,iy,gap") fail(1, "the header must be 'ix,iy,gap'");
+  const GridDims& g = P.grid;
+  const index p = P.contact_nodes();
+  std::vector<real> gap(p, -1);
+  index seen = 0;
+  while (std::getline(in, row)) {
+    ++line;
+    if (row.empty() || row == "\r") continue;
+    std::istringstream is(row);
+    long long ix, iy;
+    double v;
+    char c1, c2;
+    if (!(is >> ix >> c1 >> iy >> c2 >> v) || c1 != ',' || c2 != ',') fail(line, "'" + row + "' is not ix,iy,gap");
+    if (ix < 1 || ix > g.ex || iy < 0 || iy > g.ey)
+      fail(line, "node (" + std::to_string(ix) + ", " + std::to_string(iy) + ") is not a contact node (1 <= ix <= " +
+                     std::to_string(g.ex) + ", 0 <= iy <= " + std::to_string(g.ey) + ")");
+    if (!(v >= 0) || !std::isfinite(v)) fail(line, "gap " + std::to_string(v) + " must be >= 0 and finite");
+    const index c = (ix - 1) + g.ex * iy;
+    if (gap[c] >= 0) fail(line, "node (" + std::to_string(ix) + ", " + std::to_string(iy) + ") is given twice");
+    gap[c] = v;
+    ++seen;
+  }
+  if (seen != p)
+    throw std::invalid_argument("gap file '" + path + "' gives " + std::to_string(seen) + " of the " +
+                                std::to_string(p) + " contact nodes");
+  return gap;
 }
 
 std::string problem_json(const ProblemSpec& s, real coulomb) {

@@ -21,6 +21,7 @@
 // result file can be run again as a problem file.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "core/fem/problem.hpp"
 
@@ -35,6 +36,10 @@ struct ProblemFile {
 // throws std::invalid_argument with a one-line message
 ProblemFile read_problem_file(const std::string& path);
 ProblemFile parse_problem(const std::string& text, const std::string& origin = "problem");
+// Gaps per contact node from a CSV file with the header `ix,iy,gap` and one
+// row per contact node (1 <= ix <= ex, 0 <= iy <= ey; gap >= 0 in metres),
+// every contact node exactly once; throws with the file, line and value.
+std::vector<real> read_gap_csv(const std::string& path, const Problem& P);
 // the problem in the file's schema, as JSON text (one line)
 std::string problem_json(const ProblemSpec& s, real coulomb);
 
