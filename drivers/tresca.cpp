@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
     opt.newton.eps = a.real_value("--eps", 1e-6);
     if (!(opt.newton.eps > 0)) throw std::invalid_argument("--eps " + a.str("--eps") + " must be > 0");
     const long long mn = a.int_value("--max-newton", 50);
-    if (mn < 0 || mn > 100000) throw std::invalid_argument("--max-newton " + a.str("--max-newton") + " must be in 0..100000");
+    if (mn < 1 || mn > 100000) throw std::invalid_argument("--max-newton " + a.str("--max-newton") + " must be in 1..100000");
     opt.newton.max_iterations = int(mn);
     const std::string pc = a.str("--outer-pc", "mg");
     if (pc != "mg" && pc != "none") throw std::invalid_argument("--outer-pc '" + pc + "' must be mg or none");
@@ -153,11 +153,21 @@ int main(int argc, char** argv) {
     json_path = a.str("--json");
     csv_path = a.str("--contact-csv");
     vtk_path = a.str("--vtk");
-    for (const char* flag : {"--json", "--contact-csv", "--vtk"})
-      if (a.has(flag)) {
-        if (a.str(flag).empty()) throw std::invalid_argument(std::string("empty file name for ") + flag);
-        check_writable(a.str(flag));
-      }
+    // every output, the derived <stem>_contact.vtu included, checked before the solve
+    std::vector<std::pair<std::string, std::string>> outputs;  // (path, what)
+    if (!json_path.empty()) outputs.push_back({json_path, "--json"});
+    if (!csv_path.empty()) outputs.push_back({csv_path, "--contact-csv"});
+    if (!vtk_path.empty()) {
+      outputs.push_back({vtk_path, "--vtk"});
+      outputs.push_back({vtu_companion(vtk_path), "--vtk's contact file"});
+    }
+    for (size_t i = 0; i < outputs.size(); ++i) {
+      check_writable(outputs[i].first);
+      for (size_t j = 0; j < i; ++j)
+        if (same_file(outputs[i].first, outputs[j].first))
+          throw std::invalid_argument(outputs[i].second + " and " + outputs[j].second + " name the same file '" +
+                                      outputs[i].first + "'");
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());
     return 2;

@@ -90,6 +90,15 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --dims 4x2x2 --obstacle plane:0.01,-0.1,0", "cuts into the contact face");
   expect_error("tresca --dims 4x2x2 --obstacle plane:0,0,0 --gap 0.1", "--gap");
   expect_error("tresca --dims 4x2x2 --load-scale -2", "-2");
+  // issue 11: a path option must not swallow the next option, empty values
+  // are refused, outputs must not collide (derived names included)
+  expect_error("tresca --level 2 --json --quiet", "not the option '--quiet'");
+  expect_error("tresca --table ''", "empty");
+  expect_error("tresca --dims 4x2x2 --max-newton 0", "--max-newton 0");
+  const std::string d = ::testing::TempDir();
+  expect_error("tresca --dims 4x2x2 --json " + d + "/x --contact-csv " + d + "/x", "name the same file");
+  expect_error("tresca --dims 4x2x2 --json " + d + "/B_contact.vtu --vtk " + d + "/B.vtu", "name the same file");
+  expect_error("tresca --dims 4x2x2 --json " + d + "/a.json --contact-csv " + d + "/./a.json", "name the same file");
 }
 
 TEST(TrescaDriver, RunsTheExampleProblemFile) {

@@ -33,7 +33,11 @@ Args::Args(int argc, char** argv, const std::set<std::string>& flags, const std:
       if (!inline_value) {
         if (i + 1 >= argc) fail("option " + k + " needs a value");
         v = argv[++i];
+        // `--json --quiet` must not write a file named --quiet (a value that
+        // really starts with -- can be given as --json=--quiet)
+        if (v.rfind("--", 0) == 0) fail("option " + k + " needs a value, not the option '" + v + "'");
       }
+      if (v.empty()) fail("option " + k + " needs a value, not an empty one");
       values_[k] = v;
     } else {
       fail("unknown option '" + k + "' (see --help)");

@@ -1,5 +1,6 @@
 #include "core/io/output.hpp"
 
+#include <filesystem>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -38,6 +39,14 @@ std::string stem_of(const std::string& path) {
 
 int status_code(std::uint8_t s) { return (s & kContact) ? ((s & kStick) ? 2 : 3) : 1; }
 }  // namespace
+
+std::string vtu_companion(const std::string& vtu_path) { return stem_of(vtu_path) + "_contact.vtu"; }
+
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ea, eb;
+  const auto ca = std::filesystem::weakly_canonical(a, ea), cb = std::filesystem::weakly_canonical(b, eb);
+  return (ea || eb) ? a == b : ca == cb;
+}
 
 void check_writable(const std::string& path) {
   std::FILE* f = std::fopen((path + ".tmp").c_str(), "wb");
@@ -179,7 +188,7 @@ std::string write_vtu(const std::string& path, const Problem& P, const std::vect
     commit(std::move(f), path);
   }
   // contact face: the bottom plane as quads, its own point numbering
-  const std::string cpath = stem_of(path) + "_contact.vtu";
+  const std::string cpath = vtu_companion(path);
   FilePtr f = open_tmp(cpath);
   vtu_header(f.get(), M, g.ex * g.ey);
   std::fprintf(f.get(), "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");

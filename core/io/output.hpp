@@ -12,6 +12,11 @@ namespace tresca {
 
 // Throws if `path` cannot be created (checked before a long run starts).
 void check_writable(const std::string& path);
+// the contact-face file written next to a body VTU: "<stem>_contact.vtu"
+std::string vtu_companion(const std::string& vtu_path);
+// whether two output paths name the same file (also through "..", "." or
+// symlinked directories; neither needs to exist)
+bool same_file(const std::string& a, const std::string& b);
 void write_file_atomic(const std::string& path, const std::string& contents);
 
 // Tiny JSON object builder (keys in insertion order).
