@@ -298,6 +298,12 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "tresca: error: %s\n", e.what());
       return 3;
     }
+    // a full or closed stdout lost the report: not a success
+    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+      std::fprintf(stderr, "tresca: error: writing the report to standard output failed\n");
+      return 3;
+    }
+    if (!R.converged()) std::fprintf(stderr, "tresca: not converged (%s)\n", R.reason().c_str());
     return R.converged() ? 0 : 1;
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
     std::printf("%5s %11s %-70s %6s %9s %9s %11s %s\n", "level", "dofs", "hierarchy", "iters", "setup[s]", "solve[s]",
                 "s/iter", "rel.res (recomputed)");
     std::string rows = "[";
+    bool all_ok = true;
     for (int L : levels) {
       const Problem P = make_problem(spec_for_level(L));
       const double t0 = wall_time();
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
                   st.iterations, t1 - t0, solve, solve / std::max(1, st.iterations), rel,
                   st.ok() ? "" : to_string(st.reason));
       std::fflush(stdout);
+      all_ok = all_ok && st.ok();
       Json j;
       j.integer("level", L).integer("dofs", P.dofs()).integer("levels", mg.num_levels())
           .integer("iterations", st.iterations).num("setup", t1 - t0).num("solve", solve)
@@ -56,7 +58,8 @@ int main(int argc, char** argv) {
       rows += (rows.size() > 1 ? ",\n " : "") + j.render();
     }
     if (!json.empty()) write_file_atomic(json, rows + "]\n");
-    return 0;
+    if (!all_ok) std::fprintf(stderr, "mg_scaling: some solves did not converge (see the last column)\n");
+    return all_ok ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mg_scaling: error: %s\n", e.what());
     return 2;

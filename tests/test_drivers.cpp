@@ -18,8 +18,9 @@ struct CmdResult {
   std::string out;  // stdout and stderr together
 };
 
-CmdResult run(const std::string& args) {
-  const std::string cmd = std::string(TRESCA_BIN_DIR) + "/" + args + " 2>&1";
+// `args` starts with a binary of the build; `env` sets variables first
+CmdResult run(const std::string& args, const std::string& env = "") {
+  const std::string cmd = env + " " + std::string(TRESCA_BIN_DIR) + "/" + args + " 2>&1";
   CmdResult r{-1, ""};
   FILE* f = popen(cmd.c_str(), "r");
   if (!f) return r;
@@ -95,6 +96,7 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --level 2 --json --quiet", "not the option '--quiet'");
   expect_error("tresca --table ''", "empty");
   expect_error("tresca --dims 4x2x2 --max-newton 0", "--max-newton 0");
+
   const std::string d = ::testing::TempDir();
   expect_error("tresca --dims 4x2x2 --json " + d + "/x --contact-csv " + d + "/x", "name the same file");
   expect_error("tresca --dims 4x2x2 --json " + d + "/B_contact.vtu --vtk " + d + "/B.vtu", "name the same file");
@@ -135,9 +137,22 @@ TEST(TrescaDriver, RejectsBadProblemFiles) {
   expect_error("tresca --problem " + bad + " --table 1-2", "--table");
 }
 
+TEST(TrescaDriver, ReportsAFullStandardOutput) {
+  // stdout (and with it stderr) to a full device: the report is lost, exit 3
+  const CmdResult r = run("tresca --dims 4x2x2 > /dev/full");
+  EXPECT_EQ(r.status, 3) << r.out;
+}
+
+TEST(TrescaDriver, RefusesAnAbsurdThreadCountFromTheEnvironment) {
+  const CmdResult r = run("tresca --dims 4x2x2", "OMP_NUM_THREADS=100000");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("OMP_NUM_THREADS=100000 must be a thread count in 1..1024"), std::string::npos) << r.out;
+}
+
 TEST(TrescaDriver, ReportsNonConvergenceInOutputAndExitStatus) {
   const CmdResult r = run("tresca --dims 8x4x4 --max-newton 1 --quiet");
   EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("tresca: not converged (iteration_limit)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("NOT CONVERGED"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("iteration_limit"), std::string::npos) << r.out;
 }

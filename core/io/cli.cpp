@@ -181,6 +181,14 @@ void default_runtime_environment(char** argv) {
 }
 
 int apply_threads(const Args& a) {
+  // the runtime would try to start them all (OMP_NUM_THREADS=100000 crashed
+  // inside libgomp): the same bound as --threads
+  if (const char* env = std::getenv("OMP_NUM_THREADS"); env && !a.has("--threads")) {
+    char* end = nullptr;
+    const long long t = std::strtoll(env, &end, 10);
+    if (end == env || (*end != '\0' && *end != ',') || t < 1 || t > 1024)
+      fail(std::string("OMP_NUM_THREADS=") + env + " must be a thread count in 1..1024");
+  }
   if (a.has("--threads")) {
     const long long t = a.int_value("--threads", 1);
     if (t < 1 || t > 1024) fail("--threads " + std::to_string(t) + " must be in 1..1024");
