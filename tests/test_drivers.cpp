@@ -5,6 +5,8 @@
 
 #include <cstdio>
 #include <fstream>
+#include <sys/stat.h>
+#include <filesystem>
 #include <sstream>
 #include <algorithm>
 #include <string>
@@ -190,8 +192,43 @@ TEST(TrescaDriver, WritesJsonCsvAndVtk) {
   EXPECT_NE(v.find("Name=\"displacement\""), std::string::npos);
   EXPECT_NE(v.find("</VTKFile>"), std::string::npos);
   EXPECT_NE(vc.find("NumberOfPoints=\"28\" NumberOfCells=\"18\""), std::string::npos);
-  std::ifstream tmp(json + ".tmp");
-  EXPECT_FALSE(tmp.good()) << "temporary file left behind";
+  // no temporary left behind: only the four outputs carry the stem
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("t_out", 0) == 0)
+      EXPECT_TRUE(name == "t_out.json" || name == "t_out.csv" || name == "t_out.vtu" || name == "t_out_contact.vtu")
+          << "left behind: " << name;
+  }
+}
+
+TEST(TrescaDriver, OutputsNeverDestroyWhatTheyDoNotOwn) {
+  // issue 11: a special file is written in place, not replaced (as root,
+  // --json /dev/null replaced the null device); a symlink at the old fixed
+  // temporary name is not followed; a replaced file keeps its permissions;
+  // directories are refused before the solve
+  const std::string dir = ::testing::TempDir() + "/outsafe";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  CmdResult r = run("tresca --dims 4x2x2 --quiet --json /dev/null");
+  EXPECT_EQ(r.status, 0) << r.out;
+  struct stat st;
+  ASSERT_EQ(stat("/dev/null", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode)) << "/dev/null is no longer a character device";
+  {
+    std::ofstream(dir + "/precious") << "keep";
+    std::ofstream(dir + "/out.json") << "old";
+  }
+  std::filesystem::create_symlink(dir + "/precious", dir + "/out.json.tmp");
+  ASSERT_EQ(chmod((dir + "/out.json").c_str(), 0640), 0);
+  r = run("tresca --dims 4x2x2 --quiet --json " + dir + "/out.json");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(slurp(dir + "/precious"), "keep");
+  EXPECT_TRUE(std::filesystem::is_symlink(dir + "/out.json.tmp"));
+  EXPECT_NE(slurp(dir + "/out.json").find("\"converged\": true"), std::string::npos);
+  ASSERT_EQ(stat((dir + "/out.json").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 07777, 0640u);
+  expect_error("tresca --dims 4x2x2 --json " + dir, "is a directory");
+  expect_error("tresca --dims 4x2x2 --contact-csv " + dir + "/sub/", "not a file name");
 }
 
 TEST(TrescaDriver, TablePrintsPaperColumnsAndConverges) {

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+
+#include <sys/stat.h>
+#include <unistd.h>
 #include <stdexcept>
 
 #include "kernels/contact_maps.hpp"
@@ -11,25 +14,70 @@
 namespace tresca {
 
 namespace {
-using FilePtr = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
-
-FilePtr open_tmp(const std::string& path) {
-  std::FILE* f = std::fopen((path + ".tmp").c_str(), "wb");
-  if (!f) throw std::runtime_error("cannot write '" + path + "'");
-  return FilePtr(f, &std::fclose);
-}
-
-void commit(FilePtr f, const std::string& path) {
-  const bool ok = !std::ferror(f.get());
-  if (std::fclose(f.release()) != 0 || !ok) {
-    std::remove((path + ".tmp").c_str());
-    throw std::runtime_error("error while writing '" + path + "'");
+// One output file, written safely (issue 11):
+// - a path that exists and is not a regular file (a FIFO, /dev/null, a
+//   terminal) is written in place: replacing it would destroy it;
+// - otherwise the data go to a fresh temporary next to the target, created
+//   exclusively by mkstemp (no fixed name to plant a symlink at, nobody's file
+//   deleted), flushed to disk, given the replaced file's permissions (or the
+//   umask's for a new file) and renamed over the target: the file is
+//   complete or absent, never half-written;
+// - a directory, or a path ending in '/', is refused.
+class OutputFile {
+ public:
+  explicit OutputFile(const std::string& path) : path_(path) {
+    if (path.empty() || path.back() == '/') throw std::runtime_error("cannot write '" + path + "': not a file name");
+    struct stat st;
+    const bool exists = ::stat(path.c_str(), &st) == 0;
+    if (exists && S_ISDIR(st.st_mode)) throw std::runtime_error("cannot write '" + path + "': it is a directory");
+    if (exists && !S_ISREG(st.st_mode)) {
+      f_ = std::fopen(path.c_str(), "wb");
+      if (!f_) throw std::runtime_error("cannot write '" + path + "'");
+      return;
+    }
+    tmp_ = path + ".XXXXXX";
+    const int fd = ::mkstemp(&tmp_[0]);
+    if (fd < 0) throw std::runtime_error("cannot write '" + path + "'");
+    mode_t mode;
+    if (exists) {
+      mode = st.st_mode & 07777;
+    } else {
+      const mode_t mask = ::umask(0);
+      ::umask(mask);
+      mode = 0666 & ~mask;
+    }
+    ::fchmod(fd, mode);
+    f_ = ::fdopen(fd, "wb");
+    if (!f_) {
+      ::close(fd);
+      ::unlink(tmp_.c_str());
+      throw std::runtime_error("cannot write '" + path + "'");
+    }
   }
-  if (std::rename((path + ".tmp").c_str(), path.c_str()) != 0) {
-    std::remove((path + ".tmp").c_str());
-    throw std::runtime_error("cannot rename '" + path + ".tmp' to '" + path + "'");
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+  ~OutputFile() {
+    if (f_) std::fclose(f_);
+    if (!tmp_.empty()) ::unlink(tmp_.c_str());  // not committed: no debris
   }
-}
+  std::FILE* get() const { return f_; }
+  void commit() {
+    bool ok = std::fflush(f_) == 0 && !std::ferror(f_);
+    if (ok && !tmp_.empty()) ok = ::fsync(::fileno(f_)) == 0;
+    ok = std::fclose(f_) == 0 && ok;
+    f_ = nullptr;
+    if (!ok) throw std::runtime_error("error while writing '" + path_ + "'");
+    if (!tmp_.empty()) {
+      if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
+        throw std::runtime_error("cannot rename the temporary file to '" + path_ + "'");
+      tmp_.clear();
+    }
+  }
+
+ private:
+  std::string path_, tmp_;
+  std::FILE* f_ = nullptr;
+};
 
 std::string stem_of(const std::string& path) {
   const auto slash = path.find_last_of('/');
@@ -49,16 +97,27 @@ bool same_file(const std::string& a, const std::string& b) {
 }
 
 void check_writable(const std::string& path) {
-  std::FILE* f = std::fopen((path + ".tmp").c_str(), "wb");
-  if (!f) throw std::invalid_argument("cannot write output file '" + path + "'");
-  std::fclose(f);
-  std::remove((path + ".tmp").c_str());
+  if (path.empty() || path.back() == '/') throw std::invalid_argument("output file '" + path + "' is not a file name");
+  struct stat st;
+  if (::stat(path.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) throw std::invalid_argument("output file '" + path + "' is a directory");
+    if (!S_ISREG(st.st_mode)) {  // written in place: it must be writable
+      if (::access(path.c_str(), W_OK) != 0) throw std::invalid_argument("cannot write output file '" + path + "'");
+      return;
+    }
+  }
+  // a temporary next to it, as the writer will make
+  std::string tmp = path + ".XXXXXX";
+  const int fd = ::mkstemp(&tmp[0]);
+  if (fd < 0) throw std::invalid_argument("cannot write output file '" + path + "'");
+  ::close(fd);
+  ::unlink(tmp.c_str());
 }
 
 void write_file_atomic(const std::string& path, const std::string& contents) {
-  FilePtr f = open_tmp(path);
+  OutputFile f(path);
   std::fwrite(contents.data(), 1, contents.size(), f.get());
-  commit(std::move(f), path);
+  f.commit();
 }
 
 std::string json_number(double v) {
@@ -110,7 +169,7 @@ std::string Json::render() const {
 }
 
 void write_contact_csv(const std::string& path, const Problem& P, const ContactFields& c) {
-  FilePtr f = open_tmp(path);
+  OutputFile f(path);
   const index p = P.contact_nodes();
   const GridDims& g = P.grid;
   std::fprintf(f.get(), "ix,iy,x,y,ux,uy,uz,lambda,phi,gap,contact,stick\n");
@@ -121,7 +180,7 @@ void write_contact_csv(const std::string& path, const Problem& P, const ContactF
                  (long long)iy, g.x0 + ix * g.hx(), g.y0 + iy * g.hy(), (*c.u)[i], (*c.u)[p + i], (*c.u)[2 * p + i],
                  (*c.lambda)[i], (*c.phi)[i], (*c.gap)[i], (s & kContact) ? 1 : 0, (s & kStick) ? 1 : 0);
   }
-  commit(std::move(f), path);
+  f.commit();
 }
 
 namespace {
@@ -152,7 +211,7 @@ std::string write_vtu(const std::string& path, const Problem& P, const std::vect
   std::vector<index> cid(M, -1);
   for (index i = 0; i < p; ++i) cid[P.contact_grid_node(i)] = i;
   {
-    FilePtr f = open_tmp(path);
+    OutputFile f(path);
     vtu_header(f.get(), N, g.ex * g.ey * g.ez);
     std::fprintf(f.get(), "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
     for (index iz = 0; iz < g.nz(); ++iz)
@@ -185,11 +244,11 @@ std::string write_vtu(const std::string& path, const Problem& P, const std::vect
       std::fprintf(f.get(), "%d\n", i < 0 ? 0 : status_code((*c.status)[i]));
     }
     std::fprintf(f.get(), "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-    commit(std::move(f), path);
+    f.commit();
   }
   // contact face: the bottom plane as quads, its own point numbering
   const std::string cpath = vtu_companion(path);
-  FilePtr f = open_tmp(cpath);
+  OutputFile f(cpath);
   vtu_header(f.get(), M, g.ex * g.ey);
   std::fprintf(f.get(), "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
   for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%.9g %.9g %.9g\n", g.x0 + (n % g.nx()) * g.hx(), g.y0 + (n / g.nx()) * g.hy(), g.z0);
@@ -206,7 +265,7 @@ std::string write_vtu(const std::string& path, const Problem& P, const std::vect
   std::fprintf(f.get(), "</DataArray>\n<DataArray type=\"UInt8\" Name=\"contact_status\" format=\"ascii\">\n");
   for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%d\n", cid[n] < 0 ? 0 : status_code((*c.status)[cid[n]]));
   std::fprintf(f.get(), "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-  commit(std::move(f), cpath);
+  f.commit();
   return cpath;
 }
 

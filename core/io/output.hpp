@@ -1,6 +1,9 @@
-// Output writers. Every file is written completely or not at all: data go to
-// "<path>.tmp" first, which is renamed over <path> only after a successful
-// close. Failures throw std::runtime_error naming the path.
+// Output writers. Every regular file is written completely or not at all:
+// data go to a fresh temporary next to it (mkstemp: exclusive, never a
+// symlink), flushed to disk and renamed over <path>, which keeps its
+// permissions; special files (FIFOs, /dev/null) are written in place;
+// directories are refused (output.cpp: OutputFile). Failures throw
+// std::runtime_error naming the path.
 #pragma once
 #include <cstdint>
 #include <string>
