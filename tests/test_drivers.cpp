@@ -139,6 +139,14 @@ TEST(TrescaDriver, RejectsBadProblemFiles) {
   expect_error("tresca --problem " + bad + " --table 1-2", "--table");
 }
 
+TEST(TrescaDriver, StopsWhenTheStepSystemsAreNotBeingSolved) {
+  // issue 11: nu = 0.4999 on 16x8x8 ground on for 825 s before stagnation;
+  // two Newton steps in a row with the boundary CG at its limit now stop it
+  const CmdResult r = run("tresca --dims 16x8x8 --nu 0.4999 --quiet");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("outer_solver_failure"), std::string::npos) << r.out;
+}
+
 TEST(TrescaDriver, ReportsAFullStandardOutput) {
   // stdout (and with it stderr) to a full device: the report is lost, exit 3
   const CmdResult r = run("tresca --dims 4x2x2 > /dev/full");

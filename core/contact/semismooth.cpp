@@ -20,6 +20,7 @@ const char* to_string(NewtonReason r) {
     case NewtonReason::stagnation: return "stagnation";
     case NewtonReason::inner_failure: return "inner_solver_failure";
     case NewtonReason::non_finite: return "non_finite";
+    case NewtonReason::outer_failure: return "outer_solver_failure";
   }
   return "?";
 }
@@ -259,6 +260,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   const real* scale_ptr = scale.empty() ? nullptr : scale.data();
 
   const real bnorm = norm2(n3, btilde.data());
+  bool last_step_hit_limit = false;
   real eta = opt.forcing_max;
   for (int k = 0;; ++k) {
     // 1. approximation step at x = (u, lambda), r = S u - b̃
@@ -303,7 +305,10 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     if (step.inner_failed) return finish(NewtonReason::inner_failure);
     if (step.outer.reason == SolveReason::non_finite) return finish(NewtonReason::non_finite);
     if (step.outer.reason == SolveReason::breakdown) return finish(NewtonReason::inner_failure);
-    if (step.outer.reason == SolveReason::max_iterations) R.outer_limit_hits += 1;  // inexact step taken
+    const bool limit = step.outer.reason == SolveReason::max_iterations;
+    if (limit) R.outer_limit_hits += 1;  // inexact step taken
+    if (limit && last_step_hit_limit) return finish(NewtonReason::outer_failure);
+    last_step_hit_limit = limit;
 
     // 4. update x = (u, lambda) and S u. The step may be inexact, but S Δu
     // must be accurate: S u is kept incrementally and its error stays in every

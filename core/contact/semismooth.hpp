@@ -38,7 +38,10 @@
 
 namespace tresca {
 
-enum class NewtonReason { converged, iteration_limit, stagnation, inner_failure, non_finite };
+// outer_failure: two Newton steps in a row whose boundary CG stopped at its
+// iteration limit (the step systems are not being solved: e.g. nearly
+// incompressible material, where it used to grind on for minutes)
+enum class NewtonReason { converged, iteration_limit, stagnation, inner_failure, non_finite, outer_failure };
 const char* to_string(NewtonReason r);
 
 struct NewtonProgress {
