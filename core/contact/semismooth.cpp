@@ -274,6 +274,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
                                            R.status.data()));
     }
     R.history.push_back(vnorm);
+    R.inner_history.push_back(work.iterations);
+    R.outer_history.push_back(R.outer_iterations);
     if (opt.progress) {
       NewtonProgress pr{k, vnorm, 0, 0, 0, 0, work.iterations, R.outer_iterations, wall_time() - t0};
       for (index i = 0; i < p; ++i) {

@@ -103,6 +103,7 @@ struct NewtonResult {
   NewtonReason reason = NewtonReason::iteration_limit;
   int iterations = 0;                  // Newton steps taken
   std::vector<real> history;           // ||v̂|| after each approximation step (first at x0)
+  std::vector<long long> inner_history, outer_history;  // cumulative inner / outer CG iterations there
   std::vector<real> u, lambda, Su;     // 3p, p, 3p
   std::vector<std::uint8_t> status;    // per node: kContact | kStick at the last approximation step
   std::vector<real> phi;               // the Tresca bound of the last approximation step

@@ -66,7 +66,9 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
       .num("phi", R.coulomb ? NAN : spec.phi).num("gap", spec.obstacle.gap).raw("obstacle", obstacle.render()).num("load_scale", spec.load_scale).num("eps", eps).integer("threads", threads).str("build", build_info())
       .str("mg_precision", to_string(opt.mg.precision)).integer("newton_iterations", N.iterations)
       .boolean("converged", R.converged()).str("reason", R.reason())
-      .array("residual_history", N.history).num("final_residual", N.history.empty() ? NAN : N.history.back())
+      .array("residual_history", N.history)
+      .array("inner_iterations_history", std::vector<double>(N.inner_history.begin(), N.inner_history.end()))
+      .array("outer_iterations_history", std::vector<double>(N.outer_history.begin(), N.outer_history.end())).num("final_residual", N.history.empty() ? NAN : N.history.back())
       .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
       .raw("times", times.render()).raw("counts", counts.render()).raw("contact", contact.render())
       .raw("kkt", kkt.render()).raw("problem", problem_json(spec, R.coulomb ? opt.coulomb : -1)).raw("nested", nested).raw("coulomb", R.coulomb ? coulomb.render() : "null").num("peak_memory_bytes", R.peak_memory);
