@@ -288,12 +288,14 @@ int main(int argc, char** argv) {
                              profile_table(R.times.total).c_str());
     try {
       const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.contact.phi, &R.contact.gap};
-      if (!json_path.empty()) write_file_atomic(json_path, run_summary(spec, R, threads, opt).render() + "\n");
-      if (!csv_path.empty()) write_contact_csv(csv_path, *R.problem, cf);
-      if (!vtk_path.empty()) {
-        const std::string second = write_vtu(vtk_path, *R.problem, R.u_full, cf);
-        if (!quiet) std::printf("wrote %s and %s\n", vtk_path.c_str(), second.c_str());
-      }
+      // all of the run's outputs, or none of them (output.hpp: OutputSet)
+      OutputSet out;
+      if (!json_path.empty()) write_text(out, json_path, run_summary(spec, R, threads, opt).render() + "\n");
+      if (!csv_path.empty()) write_contact_csv(out, csv_path, *R.problem, cf);
+      std::string second;
+      if (!vtk_path.empty()) second = write_vtu(out, vtk_path, *R.problem, R.u_full, cf);
+      out.publish();
+      if (!vtk_path.empty() && !quiet) std::printf("wrote %s and %s\n", vtk_path.c_str(), second.c_str());
     } catch (const std::exception& e) {
       std::fprintf(stderr, "tresca: error: %s\n", e.what());
       return 3;

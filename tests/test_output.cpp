@@ -2,6 +2,7 @@
 // JSON run summary against the solver's own arrays, on a small case where
 // nodes stick, slide and separate. The files are parsed back independently.
 #include <gtest/gtest.h>
+#include <filesystem>
 
 #include <array>
 #include <cmath>
@@ -83,7 +84,11 @@ TEST_F(OutputFiles, TheCaseHasEveryKindOfContactNode) {
 
 TEST_F(OutputFiles, ContactCsvRowsAreTheSolversValues) {
   const std::string path = ::testing::TempDir() + "tresca_out.csv";
-  write_contact_csv(path, *R_->problem, fields());
+  {
+    OutputSet out;
+    write_contact_csv(out, path, *R_->problem, fields());
+    out.publish();
+  }
   std::istringstream is(slurp(path));
   std::string line;
   std::getline(is, line);
@@ -119,9 +124,32 @@ TEST_F(OutputFiles, ContactCsvRowsAreTheSolversValues) {
   EXPECT_EQ(rows, p);
 }
 
+TEST_F(OutputFiles, AnUnpublishedSetLeavesNothing) {
+  // all or none: a set destroyed before publish() (a later output failed)
+  // writes no file and leaves no temporary; an old file stays as it was
+  const std::string dir = ::testing::TempDir() + "/unpublished";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/old.csv") << "old";
+  {
+    OutputSet out;
+    write_contact_csv(out, dir + "/old.csv", *R_->problem, fields());
+    write_text(out, dir + "/new.json", "{}");
+  }
+  EXPECT_EQ(slurp(dir + "/old.csv"), "old");
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    ++files;
+    EXPECT_EQ(e.path().filename(), "old.csv");
+  }
+  EXPECT_EQ(files, 1);
+}
+
 TEST_F(OutputFiles, VtuHoldsTheSolversFieldsOnPositiveVolumeHexahedra) {
   const std::string path = ::testing::TempDir() + "tresca_out.vtu";
-  const std::string cpath = write_vtu(path, *R_->problem, R_->u_full, fields());
+  OutputSet out;
+  const std::string cpath = write_vtu(out, path, *R_->problem, R_->u_full, fields());
+  out.publish();
   EXPECT_EQ(cpath, ::testing::TempDir() + "tresca_out_contact.vtu");
   const Problem& P = *R_->problem;
   const GridDims& g = P.grid;

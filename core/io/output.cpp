@@ -3,6 +3,9 @@
 #include <filesystem>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <cstdlib>
+#include <csignal>
 #include <memory>
 
 #include <sys/stat.h>
@@ -14,14 +17,51 @@
 namespace tresca {
 
 namespace {
+// Temporaries alive right now, removed by SIGINT / SIGTERM / SIGHUP before
+// the signal takes its default course (unlink is async-signal-safe).
+constexpr int kMaxLive = 64;
+char* g_live[kMaxLive];
+volatile std::sig_atomic_t g_handlers_installed = 0;
+
+extern "C" void remove_live_temporaries(int sig) {
+  for (int i = 0; i < kMaxLive; ++i)
+    if (g_live[i]) ::unlink(g_live[i]);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+void register_live(const std::string& tmp) {
+  if (!g_handlers_installed) {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, remove_live_temporaries);
+    g_handlers_installed = 1;
+  }
+  for (int i = 0; i < kMaxLive; ++i)
+    if (!g_live[i]) {
+      g_live[i] = ::strdup(tmp.c_str());
+      return;
+    }
+}
+
+void unregister_live(const std::string& tmp) {
+  for (int i = 0; i < kMaxLive; ++i)
+    if (g_live[i] && tmp == g_live[i]) {
+      char* p = g_live[i];
+      g_live[i] = nullptr;
+      std::free(p);
+      return;
+    }
+}
+
+}  // namespace
+
 // One output file, written safely (issue 11):
 // - a path that exists and is not a regular file (a FIFO, /dev/null, a
 //   terminal) is written in place: replacing it would destroy it;
 // - otherwise the data go to a fresh temporary next to the target, created
 //   exclusively by mkstemp (no fixed name to plant a symlink at, nobody's file
 //   deleted), flushed to disk, given the replaced file's permissions (or the
-//   umask's for a new file) and renamed over the target: the file is
-//   complete or absent, never half-written;
+//   umask's for a new file) and renamed over the target by publish(): the
+//   file is complete or absent, never half-written;
 // - a directory, or a path ending in '/', is refused.
 class OutputFile {
  public:
@@ -37,7 +77,11 @@ class OutputFile {
     }
     tmp_ = path + ".XXXXXX";
     const int fd = ::mkstemp(&tmp_[0]);
-    if (fd < 0) throw std::runtime_error("cannot write '" + path + "'");
+    if (fd < 0) {
+      tmp_.clear();
+      throw std::runtime_error("cannot write '" + path + "'");
+    }
+    register_live(tmp_);
     mode_t mode;
     if (exists) {
       mode = st.st_mode & 07777;
@@ -50,7 +94,6 @@ class OutputFile {
     f_ = ::fdopen(fd, "wb");
     if (!f_) {
       ::close(fd);
-      ::unlink(tmp_.c_str());
       throw std::runtime_error("cannot write '" + path + "'");
     }
   }
@@ -58,25 +101,54 @@ class OutputFile {
   OutputFile& operator=(const OutputFile&) = delete;
   ~OutputFile() {
     if (f_) std::fclose(f_);
-    if (!tmp_.empty()) ::unlink(tmp_.c_str());  // not committed: no debris
+    if (!tmp_.empty()) {  // not published: no debris
+      ::unlink(tmp_.c_str());
+      unregister_live(tmp_);
+    }
   }
   std::FILE* get() const { return f_; }
-  void commit() {
+  // all data on disk and the file closed; throws if any write failed
+  void finish() {
     bool ok = std::fflush(f_) == 0 && !std::ferror(f_);
     if (ok && !tmp_.empty()) ok = ::fsync(::fileno(f_)) == 0;
     ok = std::fclose(f_) == 0 && ok;
     f_ = nullptr;
     if (!ok) throw std::runtime_error("error while writing '" + path_ + "'");
-    if (!tmp_.empty()) {
-      if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
-        throw std::runtime_error("cannot rename the temporary file to '" + path_ + "'");
-      tmp_.clear();
-    }
+  }
+  // the finished temporary becomes the file
+  void publish() {
+    if (tmp_.empty()) return;
+    if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
+      throw std::runtime_error("cannot rename the temporary file to '" + path_ + "'");
+    unregister_live(tmp_);
+    tmp_.clear();
   }
 
  private:
   std::string path_, tmp_;
   std::FILE* f_ = nullptr;
+};
+
+OutputSet::OutputSet() = default;
+OutputSet::~OutputSet() = default;  // unpublished files remove their temporaries
+
+std::FILE* OutputSet::create(const std::string& path) {
+  files_.push_back(std::make_unique<OutputFile>(path));
+  return files_.back()->get();
+}
+
+void OutputSet::publish() {
+  for (auto& f : files_) f->finish();  // every file complete on disk first
+  for (auto& f : files_) f->publish();
+  files_.clear();
+}
+
+namespace {
+
+// a file of an OutputSet, for the writers' f.get() calls
+struct OutputHandle {
+  std::FILE* f;
+  std::FILE* get() const { return f; }
 };
 
 std::string stem_of(const std::string& path) {
@@ -114,10 +186,15 @@ void check_writable(const std::string& path) {
   ::unlink(tmp.c_str());
 }
 
+void write_text(OutputSet& out, const std::string& path, const std::string& contents) {
+  std::FILE* f = out.create(path);
+  std::fwrite(contents.data(), 1, contents.size(), f);
+}
+
 void write_file_atomic(const std::string& path, const std::string& contents) {
-  OutputFile f(path);
-  std::fwrite(contents.data(), 1, contents.size(), f.get());
-  f.commit();
+  OutputSet out;
+  write_text(out, path, contents);
+  out.publish();
 }
 
 std::string json_number(double v) {
@@ -168,8 +245,8 @@ std::string Json::render() const {
   return s + "}";
 }
 
-void write_contact_csv(const std::string& path, const Problem& P, const ContactFields& c) {
-  OutputFile f(path);
+void write_contact_csv(OutputSet& out, const std::string& path, const Problem& P, const ContactFields& c) {
+  OutputHandle f{out.create(path)};
   const index p = P.contact_nodes();
   const GridDims& g = P.grid;
   std::fprintf(f.get(), "ix,iy,x,y,ux,uy,uz,lambda,phi,gap,contact,stick\n");
@@ -180,7 +257,6 @@ void write_contact_csv(const std::string& path, const Problem& P, const ContactF
                  (long long)iy, g.x0 + ix * g.hx(), g.y0 + iy * g.hy(), (*c.u)[i], (*c.u)[p + i], (*c.u)[2 * p + i],
                  (*c.lambda)[i], (*c.phi)[i], (*c.gap)[i], (s & kContact) ? 1 : 0, (s & kStick) ? 1 : 0);
   }
-  f.commit();
 }
 
 namespace {
@@ -203,7 +279,7 @@ void vtu_cells(std::FILE* f, const std::vector<index>& conn, int per_cell, int v
 }
 }  // namespace
 
-std::string write_vtu(const std::string& path, const Problem& P, const std::vector<real>& u_full,
+std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
                       const ContactFields& c) {
   const GridDims& g = P.grid;
   const index N = g.nodes(), p = P.contact_nodes(), M = g.nx() * g.ny();
@@ -211,7 +287,7 @@ std::string write_vtu(const std::string& path, const Problem& P, const std::vect
   std::vector<index> cid(M, -1);
   for (index i = 0; i < p; ++i) cid[P.contact_grid_node(i)] = i;
   {
-    OutputFile f(path);
+    OutputHandle f{out.create(path)};
     vtu_header(f.get(), N, g.ex * g.ey * g.ez);
     std::fprintf(f.get(), "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
     for (index iz = 0; iz < g.nz(); ++iz)
@@ -244,11 +320,10 @@ std::string write_vtu(const std::string& path, const Problem& P, const std::vect
       std::fprintf(f.get(), "%d\n", i < 0 ? 0 : status_code((*c.status)[i]));
     }
     std::fprintf(f.get(), "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-    f.commit();
   }
   // contact face: the bottom plane as quads, its own point numbering
   const std::string cpath = vtu_companion(path);
-  OutputFile f(cpath);
+  OutputHandle f{out.create(cpath)};
   vtu_header(f.get(), M, g.ex * g.ey);
   std::fprintf(f.get(), "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
   for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%.9g %.9g %.9g\n", g.x0 + (n % g.nx()) * g.hx(), g.y0 + (n / g.nx()) * g.hy(), g.z0);
@@ -265,7 +340,6 @@ std::string write_vtu(const std::string& path, const Problem& P, const std::vect
   std::fprintf(f.get(), "</DataArray>\n<DataArray type=\"UInt8\" Name=\"contact_status\" format=\"ascii\">\n");
   for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%d\n", cid[n] < 0 ? 0 : status_code((*c.status)[cid[n]]));
   std::fprintf(f.get(), "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-  f.commit();
   return cpath;
 }
 

@@ -6,6 +6,8 @@
 // std::runtime_error naming the path.
 #pragma once
 #include <cstdint>
+#include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,25 @@ std::string vtu_companion(const std::string& vtu_path);
 // whether two output paths name the same file (also through "..", "." or
 // symlinked directories; neither needs to exist)
 bool same_file(const std::string& a, const std::string& b);
+// The files of one run, written all or none: each goes to its own temporary
+// (OutputFile's rules above), and publish() renames them only after every
+// one of them is complete on disk. Destroyed unpublished (a failed write, an
+// exception), the set removes its temporaries; SIGINT, SIGTERM and SIGHUP
+// remove them too. So after an interruption a user has either the run's
+// complete new outputs or the old ones, never a mixture or debris.
+class OutputFile;
+class OutputSet {
+ public:
+  OutputSet();
+  ~OutputSet();
+  std::FILE* create(const std::string& path);  // stays owned by the set
+  void publish();
+
+ private:
+  std::vector<std::unique_ptr<OutputFile>> files_;
+};
+void write_text(OutputSet& out, const std::string& path, const std::string& contents);
+// one file on its own: write_text + publish
 void write_file_atomic(const std::string& path, const std::string& contents);
 
 // Tiny JSON object builder (keys in insertion order).
@@ -48,12 +69,12 @@ struct ContactFields {
   const std::vector<real>* gap;     // p: gap to the obstacle per node
 };
 
-void write_contact_csv(const std::string& path, const Problem& P, const ContactFields& c);
+void write_contact_csv(OutputSet& out, const std::string& path, const Problem& P, const ContactFields& c);
 // Body as VTK XML unstructured grid (hexahedra) with point data displacement,
 // contact_force and contact_status (0 not a contact node, 1 separated,
 // 2 contact+stick, 3 contact+slip); the contact face (quads) goes to
 // "<stem>_contact.vtu" next to it. Returns the second file's path.
-std::string write_vtu(const std::string& path, const Problem& P, const std::vector<real>& u_full,
+std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
                       const ContactFields& c);
 
 }  // namespace tresca
