@@ -98,6 +98,13 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --level 2 --json --quiet", "not the option '--quiet'");
   expect_error("tresca --table ''", "empty");
   expect_error("tresca --dims 4x2x2 --max-newton 0", "--max-newton 0");
+  // messages say the value as given, and not 100 KB of it
+  expect_error("tresca --dims 4x2x2 --nu 0.5", "nu = 0.5 ");
+  expect_error("tresca --dims 4x2x2 --nu 0.50000001", "0.50000001");
+  expect_error("tresca --dims 4x2x2 --phi 1e999", "not a finite number");
+  const CmdResult longv = run("tresca --dims 4x2x2 --phi " + std::string(100000, '7') + "x");
+  EXPECT_EQ(longv.status, 2);
+  EXPECT_LT(longv.out.size(), 300u) << longv.out.size();
 
   const std::string d = ::testing::TempDir();
   expect_error("tresca --dims 4x2x2 --json " + d + "/x --contact-csv " + d + "/x", "name the same file");
@@ -157,6 +164,12 @@ TEST(TrescaDriver, AnInterruptLeavesNoDebris) {
     std::sort(left.begin(), left.end());
     EXPECT_EQ(left, (std::vector<std::string>{"o.json", "o.vtu", "o_contact.vtu"}));
   }
+}
+
+TEST(TrescaDriver, TakesATinyButNonzeroNumber) {
+  // 1e-320 is a denormal, not "not a finite number"
+  const CmdResult r = run("tresca --dims 4x2x2 --quiet --phi 1e-320");
+  EXPECT_EQ(r.status, 0) << r.out;
 }
 
 TEST(TrescaDriver, StopsWhenTheStepSystemsAreNotBeingSolved) {

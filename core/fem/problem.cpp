@@ -67,6 +67,7 @@ real Obstacle::gap_at(real x, real y) const {
 
 void validate(const ProblemSpec& s) {
   std::ostringstream os;
+  os.precision(12);  // nu = 0.49999999 must not print as 0.5
   if (s.ex < 1 || s.ey < 1 || s.ez < 1) {
     os << "element counts " << s.ex << "x" << s.ey << "x" << s.ez << " must all be >= 1";
     fail(os.str());

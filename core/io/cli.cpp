@@ -14,6 +14,10 @@ namespace tresca {
 
 namespace {
 [[noreturn]] void fail(const std::string& m) { throw std::invalid_argument(m); }
+// a user's value inside a one-line message: at most 80 characters of it
+std::string quoted(const std::string& v) {
+  return "'" + (v.size() > 80 ? v.substr(0, 77) + "..." : v) + "'";
+}
 }  // namespace
 
 Args::Args(int argc, char** argv, const std::set<std::string>& flags, const std::set<std::string>& switches) {
@@ -40,7 +44,7 @@ Args::Args(int argc, char** argv, const std::set<std::string>& flags, const std:
       if (v.empty()) fail("option " + k + " needs a value, not an empty one");
       values_[k] = v;
     } else {
-      fail("unknown option '" + k + "' (see --help)");
+      fail("unknown option " + quoted(k) + " (see --help)");
     }
   }
 }
@@ -56,8 +60,10 @@ double Args::real_value(const std::string& k, double def) const {
   char* end = nullptr;
   errno = 0;
   const double v = std::strtod(s.c_str(), &end);
-  if (s.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v))
-    fail("option " + k + ": '" + s + "' is not a finite number");
+  // ERANGE on underflow (1e-320, a denormal) still gives a usable number; on
+  // overflow it gives +-HUGE_VAL, caught as not finite
+  if (s.empty() || *end != '\0' || !std::isfinite(v))
+    fail("option " + k + ": " + quoted(s) + " is not a finite number");
   return v;
 }
 
@@ -67,7 +73,7 @@ long long Args::int_value(const std::string& k, long long def) const {
   char* end = nullptr;
   errno = 0;
   const long long v = std::strtoll(s.c_str(), &end, 10);
-  if (s.empty() || *end != '\0' || errno == ERANGE) fail("option " + k + ": '" + s + "' is not an integer");
+  if (s.empty() || *end != '\0' || errno == ERANGE) fail("option " + k + ": " + quoted(s) + " is not an integer");
   return v;
 }
 
