@@ -1,10 +1,12 @@
 // tresca: 3D linear-elastic contact with Tresca friction by the semismooth*
 // Newton method, matrix-free on the contact boundary. See --help.
-// Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure.
+// Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure,
+// 4 out of memory.
 #include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <stdexcept>
 #include <string>
 
@@ -58,7 +60,7 @@ const char* kHelp =
     "  --profile          per-kernel time, GB/s and GFLOP/s after the run\n"
     "  --quiet            no progress lines\n"
     "  --help             this text\n"
-    "Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure.\n";
+    "Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure, 4 out of memory.\n";
 
 // The paper's Table 1 (MATLAB): level, n, assembly [s], Cholesky & Schur [s], p, solver [s], iterations
 struct PaperRow {
@@ -310,6 +312,9 @@ int main(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());
     return 2;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "tresca: error: out of memory (the estimate is printed first; try a smaller mesh)\n");
+    return 4;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());
     return 1;

@@ -166,6 +166,14 @@ TEST(TrescaDriver, AnInterruptLeavesNoDebris) {
   }
 }
 
+TEST(TrescaDriver, RefusesARunBeyondTheAddressSpaceLimit) {
+  // issue 11: under `ulimit -v` a large run failed after minutes as if "not
+  // converged"; the estimate is now held against that limit before starting
+  const CmdResult r = run("tresca --level 11 --quiet", "ulimit -v 400000;");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("ulimit -v"), std::string::npos) << r.out;
+}
+
 TEST(TrescaDriver, TakesATinyButNonzeroNumber) {
   // 1e-320 is a denormal, not "not a finite number"
   const CmdResult r = run("tresca --dims 4x2x2 --quiet --phi 1e-320");

@@ -3,6 +3,8 @@
 #include <utility>
 #include <omp.h>
 #include <unistd.h>
+#include <fstream>
+#include <sys/resource.h>
 
 #include <cerrno>
 #include <cmath>
@@ -163,14 +165,31 @@ std::vector<int> parse_level_range(const std::string& s) {
   return r;
 }
 
+namespace {
+// the memory this process may use: physical memory, the address-space limit
+// (ulimit -v) and the cgroup's limit (containers), whichever is least
+std::pair<double, std::string> memory_limit() {
+  std::pair<double, std::string> m{double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE)), "this machine's"};
+  struct rlimit rl;
+  if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY && double(rl.rlim_cur) < m.first)
+    m = {double(rl.rlim_cur), "the address-space limit's (ulimit -v)"};
+  for (const char* f : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+    std::ifstream in(f);
+    double v = 0;
+    if (in >> v && v > 0 && v < m.first) m = {v, "the cgroup's memory limit's"};
+  }
+  return m;
+}
+}  // namespace
+
 void check_memory(const ProblemSpec& s) {
   const double need = estimated_memory_bytes(s);
-  const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  const auto [have, whose] = memory_limit();
   if (have > 0 && need > 0.9 * have) {
     std::ostringstream os;
     if (s.level >= 0) os << "level " << s.level << " (";
-    os << "mesh " << dims_string(s) << (s.level >= 0 ? ")" : "") << " needs about " << need / 1e9 << " GB, more than this machine's "
-       << have / 1e9 << " GB";
+    os << "mesh " << dims_string(s) << (s.level >= 0 ? ")" : "") << " needs about " << need / 1e9 << " GB, more than "
+       << whose << " " << have / 1e9 << " GB";
     fail(os.str());
   }
 }
