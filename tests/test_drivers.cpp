@@ -41,6 +41,13 @@ std::string slurp(const std::string& path) {
   return s.str();
 }
 
+// a run ending with `status`, its output containing `says` (if given)
+void expect_run(const std::string& args, int status, const std::string& says, const std::string& env = "") {
+  const CmdResult r = run(args, env);
+  EXPECT_EQ(r.status, status) << args << "\n" << r.out;
+  if (!says.empty()) EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
+}
+
 void expect_error(const std::string& args, const std::string& names) {
   const CmdResult r = run(args);
   EXPECT_EQ(r.status, 2) << args << "\n" << r.out;
@@ -169,35 +176,27 @@ TEST(TrescaDriver, AnInterruptLeavesNoDebris) {
 TEST(TrescaDriver, RefusesARunBeyondTheAddressSpaceLimit) {
   // issue 11: under `ulimit -v` a large run failed after minutes as if "not
   // converged"; the estimate is now held against that limit before starting
-  const CmdResult r = run("tresca --level 11 --quiet", "ulimit -v 400000;");
-  EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("ulimit -v"), std::string::npos) << r.out;
+  expect_run("tresca --level 11 --quiet", 2, "ulimit -v", "ulimit -v 400000;");
 }
 
 TEST(TrescaDriver, TakesATinyButNonzeroNumber) {
   // 1e-320 is a denormal, not "not a finite number"
-  const CmdResult r = run("tresca --dims 4x2x2 --quiet --phi 1e-320");
-  EXPECT_EQ(r.status, 0) << r.out;
+  expect_run("tresca --dims 4x2x2 --quiet --phi 1e-320", 0, "");
 }
 
 TEST(TrescaDriver, StopsWhenTheStepSystemsAreNotBeingSolved) {
   // issue 11: nu = 0.4999 on 16x8x8 ground on for 825 s before stagnation;
   // two Newton steps in a row with the boundary CG at its limit now stop it
-  const CmdResult r = run("tresca --dims 16x8x8 --nu 0.4999 --quiet");
-  EXPECT_EQ(r.status, 1) << r.out;
-  EXPECT_NE(r.out.find("outer_solver_failure"), std::string::npos) << r.out;
+  expect_run("tresca --dims 16x8x8 --nu 0.4999 --quiet", 1, "outer_solver_failure");
 }
 
 TEST(TrescaDriver, ReportsAFullStandardOutput) {
   // stdout (and with it stderr) to a full device: the report is lost, exit 3
-  const CmdResult r = run("tresca --dims 4x2x2 > /dev/full");
-  EXPECT_EQ(r.status, 3) << r.out;
+  expect_run("tresca --dims 4x2x2 > /dev/full", 3, "");
 }
 
 TEST(TrescaDriver, RefusesAnAbsurdThreadCountFromTheEnvironment) {
-  const CmdResult r = run("tresca --dims 4x2x2", "OMP_NUM_THREADS=100000");
-  EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("OMP_NUM_THREADS=100000 must be a thread count in 1..1024"), std::string::npos) << r.out;
+  expect_run("tresca --dims 4x2x2", 2, "OMP_NUM_THREADS=100000 must be a thread count in 1..1024", "OMP_NUM_THREADS=100000");
 }
 
 TEST(TrescaDriver, ReportsNonConvergenceInOutputAndExitStatus) {
