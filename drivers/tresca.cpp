@@ -114,9 +114,8 @@ int main(int argc, char** argv) {
       if (a.has("--gap") || a.has("--obstacle"))
         throw std::invalid_argument("--gap-file excludes --gap and --obstacle");
       if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's problem; it takes no --gap-file");
-      const Problem P = make_problem(spec);
-      opt.contact = contact_conditions(P);
-      opt.contact.gap = read_gap_csv(a.str("--gap-file"), P);
+      opt.contact = contact_conditions(spec);
+      opt.contact.gap = read_gap_csv(a.str("--gap-file"), grid_of(spec));
     }
     opt.newton.eps = a.real_value("--eps", 1e-6);
     if (!(opt.newton.eps > 0)) throw std::invalid_argument("--eps " + a.str("--eps") + " must be > 0");

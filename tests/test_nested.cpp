@@ -33,7 +33,7 @@ TEST(Nested, ContactAreasTileTheFace) {
   for (auto d : {std::array<index, 3>{6, 3, 2}, std::array<index, 3>{7, 5, 3}}) {
     const Problem P = make_problem(spec_for_dims(d[0], d[1], d[2]));
     real sum = 0;
-    for (index c = 0; c < P.contact_nodes(); ++c) sum += contact_area(P, c);
+    for (index c = 0; c < P.contact_nodes(); ++c) sum += contact_area(P.grid, c);
     EXPECT_NEAR(sum, P.grid.lx * P.grid.ly - 0.5 * P.grid.hx() * P.grid.ly, 1e-14);
   }
 }
@@ -50,14 +50,14 @@ TEST(Nested, ProlongationIsExactForBilinearDisplacementsAndPressures) {
     std::vector<real> uc(3 * pc), lc(pc), uf, lf;
     for (index j = 0; j < pc; ++j) {
       for (int a = 0; a < 3; ++a) uc[a * pc + j] = u_of(a, node_x(C, j), node_y(C, j));
-      lc[j] = p_of(node_y(C, j)) * contact_area(C, j);
+      lc[j] = p_of(node_y(C, j)) * contact_area(C.grid, j);
     }
-    prolongate_contact(C, uc, lc, F, uf, lf);
+    prolongate_contact(C.grid, uc, lc, F.grid, uf, lf);
     ASSERT_EQ(index(uf.size()), 3 * pf);
     ASSERT_EQ(index(lf.size()), pf);
     for (index i = 0; i < pf; ++i) {
       for (int a = 0; a < 3; ++a) EXPECT_NEAR(uf[a * pf + i], u_of(a, node_x(F, i), node_y(F, i)), 1e-14) << i;
-      EXPECT_NEAR(lf[i], p_of(node_y(F, i)) * contact_area(F, i), 1e-7) << i;
+      EXPECT_NEAR(lf[i], p_of(node_y(F, i)) * contact_area(F.grid, i), 1e-7) << i;
     }
   }
 }
@@ -70,7 +70,7 @@ TEST(Nested, CoarseConditionsCarryDensities) {
   const Problem C = make_problem(coarser_spec(F.spec));
   ContactConditions f = ContactConditions::uniform(F.contact_nodes(), 2.5e5, 0);
   for (index i = 0; i < F.contact_nodes(); ++i) f.gap[i] = 0.01 * node_x(F, i) + 0.002 * node_y(F, i);
-  const ContactConditions c = coarse_conditions(F, f, C);
+  const ContactConditions c = coarse_conditions(F.grid, f, C.grid);
   ASSERT_EQ(index(c.phi.size()), C.contact_nodes());
   for (index j = 0; j < C.contact_nodes(); ++j) {
     EXPECT_NEAR(c.phi[j], 4 * 2.5e5, 1e-6) << j;

@@ -138,13 +138,13 @@ TEST(GapFile, ReadsEveryContactNodeAndRejectsTheRest) {
   for (int iy = 0; iy <= 2; ++iy)
     for (int ix = 1; ix <= 3; ++ix) good += std::to_string(ix) + "," + std::to_string(iy) + "," + std::to_string(0.01 * ix + 0.1 * iy) + "\n";
   write(good);
-  const std::vector<real> g = read_gap_csv(path, P);
+  const std::vector<real> g = read_gap_csv(path, P.grid);
   ASSERT_EQ(index(g.size()), P.contact_nodes());
   for (index c = 0; c < P.contact_nodes(); ++c) EXPECT_NEAR(g[c], 0.01 * (1 + c % 3) + 0.1 * (c / 3), 1e-12) << c;
   auto error = [&](const std::string& body) -> std::string {
     write(body);
     try {
-      read_gap_csv(path, P);
+      read_gap_csv(path, P.grid);
     } catch (const std::invalid_argument& e) {
       return e.what();
     }

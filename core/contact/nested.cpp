@@ -19,14 +19,15 @@ bool has_coarser(const ProblemSpec& s, index min_contact_nodes) {
   return c.ex < s.ex && c.ex >= 2 && c.ey >= 2 && c.ez >= 2 && c.contact_nodes() >= min_contact_nodes;
 }
 
-real contact_area(const Problem& P, index c) {
-  const GridDims& g = P.grid;
+real contact_area(const GridDims& g, index c) {
   const index ix = 1 + c % g.ex, iy = c / g.ex;
   const real ax = ix == g.ex ? 0.5 : 1, ay = (iy == 0 || iy == g.ey) ? 0.5 : 1;
   return ax * ay * g.hx() * g.hy();
 }
 
 namespace {
+
+index contact_nodes(const GridDims& g) { return g.ex * g.ny(); }
 
 // contact node of the bottom-face node (ix >= 1, iy)
 index contact_index(const GridDims& g, index ix, index iy) { return (ix - 1) + g.ex * iy; }
@@ -44,25 +45,23 @@ real bilinear(const GridDims& g, const std::vector<real>& f, real x, real y) {
 
 }  // namespace
 
-ContactConditions coarse_conditions(const Problem& fine, const ContactConditions& f, const Problem& coarse) {
-  const GridDims &gf = fine.grid, &gc = coarse.grid;
-  const index pc = coarse.contact_nodes();
+ContactConditions coarse_conditions(const GridDims& gf, const ContactConditions& f, const GridDims& gc) {
+  const index pc = contact_nodes(gc);
   ContactConditions c{std::vector<real>(pc), std::vector<real>(pc)};
   for (index j = 0; j < pc; ++j) {
-    const real x = gc.x0 + real(1 + j % gc.ex) * gc.hx(), y = gc.y0 + real(j / gc.ex) * gc.hy();
+    const auto [x, y] = contact_position(gc, j);
     const index ix = std::clamp(index(std::lround((x - gf.x0) / gf.hx())), index(1), gf.ex);
     const index iy = std::clamp(index(std::lround((y - gf.y0) / gf.hy())), index(0), gf.ey);
     const index i = contact_index(gf, ix, iy);
-    c.phi[j] = f.phi[i] / contact_area(fine, i) * contact_area(coarse, j);
+    c.phi[j] = f.phi[i] / contact_area(gf, i) * contact_area(gc, j);
     c.gap[j] = f.gap[i];
   }
   return c;
 }
 
-void prolongate_contact(const Problem& coarse, const std::vector<real>& uc, const std::vector<real>& lc,
-                        const Problem& fine, std::vector<real>& uf, std::vector<real>& lf) {
-  const GridDims &gc = coarse.grid, &gf = fine.grid;
-  const index pc = coarse.contact_nodes(), pf = fine.contact_nodes(), M = gc.nx() * gc.ny();
+void prolongate_contact(const GridDims& gc, const std::vector<real>& uc, const std::vector<real>& lc,
+                        const GridDims& gf, std::vector<real>& uf, std::vector<real>& lf) {
+  const index pc = contact_nodes(gc), pf = contact_nodes(gf), M = gc.nx() * gc.ny();
   // coarse fields on the whole bottom face: u = 0 on x = 0, the pressure
   // there continued from x = hx
   std::vector<real> face[4];
@@ -70,15 +69,15 @@ void prolongate_contact(const Problem& coarse, const std::vector<real>& uc, cons
   for (index j = 0; j < pc; ++j) {
     const index ix = 1 + j % gc.ex, iy = j / gc.ex, n = ix + gc.nx() * iy;
     for (int a = 0; a < 3; ++a) face[a][n] = uc[a * pc + j];
-    face[3][n] = lc[j] / contact_area(coarse, j);
+    face[3][n] = lc[j] / contact_area(gc, j);
     if (ix == 1) face[3][gc.nx() * iy] = face[3][n];
   }
   uf.assign(3 * pf, 0);
   lf.assign(pf, 0);
   for (index i = 0; i < pf; ++i) {
-    const real x = gf.x0 + real(1 + i % gf.ex) * gf.hx(), y = gf.y0 + real(i / gf.ex) * gf.hy();
+    const auto [x, y] = contact_position(gf, i);
     for (int a = 0; a < 3; ++a) uf[a * pf + i] = bilinear(gc, face[a], x, y);
-    lf[i] = std::max(real(0), bilinear(gc, face[3], x, y)) * contact_area(fine, i);
+    lf[i] = std::max(real(0), bilinear(gc, face[3], x, y)) * contact_area(gf, i);
   }
 }
 

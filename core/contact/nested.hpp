@@ -27,13 +27,13 @@ ProblemSpec coarser_spec(const ProblemSpec& s);
 bool has_coarser(const ProblemSpec& s, index min_contact_nodes);
 
 // the contact law of the fine problem on the coarse one (densities, above)
-ContactConditions coarse_conditions(const Problem& fine, const ContactConditions& f, const Problem& coarse);
+ContactConditions coarse_conditions(const GridDims& fine, const ContactConditions& f, const GridDims& coarse);
 
 // (u, lambda) of the coarse contact face interpolated to the fine one
-void prolongate_contact(const Problem& coarse, const std::vector<real>& uc, const std::vector<real>& lc,
-                        const Problem& fine, std::vector<real>& uf, std::vector<real>& lf);
+void prolongate_contact(const GridDims& coarse, const std::vector<real>& uc, const std::vector<real>& lc,
+                        const GridDims& fine, std::vector<real>& uf, std::vector<real>& lf);
 
 // A_i of contact node c: its share of the contact face
-real contact_area(const Problem& P, index c);
+real contact_area(const GridDims& g, index c);
 
 }  // namespace tresca

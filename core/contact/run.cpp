@@ -10,12 +10,13 @@
 
 namespace tresca {
 
-ContactConditions contact_conditions(const Problem& P) {
-  const index p = P.contact_nodes();
-  ContactConditions c = ContactConditions::uniform(p, P.spec.phi, 0);
+ContactConditions contact_conditions(const ProblemSpec& spec) {
+  const GridDims g = grid_of(spec);
+  const index p = spec.contact_nodes();
+  ContactConditions c = ContactConditions::uniform(p, spec.phi, 0);
   for (index i = 0; i < p; ++i) {
-    const index ix = 1 + i % P.grid.ex, iy = i / P.grid.ex;
-    c.gap[i] = P.spec.obstacle.gap_at(P.grid.x0 + real(ix) * P.grid.hx(), P.grid.y0 + real(iy) * P.grid.hy());
+    const auto [x, y] = contact_position(g, i);
+    c.gap[i] = spec.obstacle.gap_at(x, y);
   }
   return c;
 }
@@ -24,7 +25,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   RunResult R;
   const double t0 = wall_time();
   R.problem = std::make_unique<Problem>(make_problem(spec));
-  R.contact = opt.contact.phi.empty() ? contact_conditions(*R.problem) : opt.contact;
+  R.contact = opt.contact.phi.empty() ? contact_conditions(spec) : opt.contact;
   // nested iteration: the coarser mesh first (before this mesh's operators
   // exist, so the peak memory stays this mesh's). It hands up (u, lambda)
   // as the Newton initial iterate and, trilinearly interpolated, its K_ii^{-1}
@@ -42,7 +43,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     // and need their forces only to a fraction of that accuracy
     co.tight_rtol = std::max(opt.tight_rtol, 1e-3 * opt.nested_rtol);
     co.newton.book_accuracy = std::max(opt.newton.book_accuracy, 1e-3 * opt.nested_rtol);
-    co.contact = coarse_conditions(*R.problem, R.contact, make_problem(cs));
+    co.contact = coarse_conditions(R.problem->grid, R.contact, grid_of(cs));
     const RunResult C = run_tresca(cs, co);
     R.nested = C.nested;
     R.nested.push_back({cs, int(C.newton_steps()), C.converged(), C.fine_matvecs_total - C.nested_fine_matvecs,
@@ -50,7 +51,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.nested_fine_matvecs = C.fine_matvecs_total * double(cs.free_dofs()) / double(spec.free_dofs());
     if (opt.nested_done) opt.nested_done(R.nested.back());
     if (C.converged()) {
-      prolongate_contact(*C.problem, C.newton.u, C.newton.lambda, *R.problem, u0, lambda0);
+      prolongate_contact(C.problem->grid, C.newton.u, C.newton.lambda, R.problem->grid, u0, lambda0);
       newton.u0 = &u0;
       newton.lambda0 = &lambda0;
       const Transfer T = build_transfer(R.problem->grid, C.problem->grid);

@@ -41,7 +41,7 @@ struct RunOptions {
   // compute b̃ and S u to 1e-3 nested_rtol
   real nested_rtol = 1e-4;
   real tight_rtol = 1e-12;
-  // the contact law per node (p values each); empty: contact_conditions(problem)
+  // the contact law per node (p values each); empty: contact_conditions(spec)
   ContactConditions contact;
   // Coulomb friction (coulomb.hpp): coefficient F >= 0 makes the bound
   // phi_i = F lambda_i (contact.phi / spec.phi are then not used); < 0: Tresca
@@ -94,7 +94,7 @@ struct RunResult {
 };
 
 // spec.phi at every contact node, and the gap to spec.obstacle under it
-ContactConditions contact_conditions(const Problem& P);
+ContactConditions contact_conditions(const ProblemSpec& spec);
 
 RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt);
 

@@ -133,11 +133,8 @@ void validate(const ProblemSpec& s) {
   }
 }
 
-Problem make_problem(const ProblemSpec& spec) {
-  validate(spec);
-  Problem P;
-  P.spec = spec;
-  GridDims& g = P.grid;
+GridDims grid_of(const ProblemSpec& spec) {
+  GridDims g;
   g.ex = spec.ex;
   g.ey = spec.ey;
   g.ez = spec.ez;
@@ -147,6 +144,15 @@ Problem make_problem(const ProblemSpec& spec) {
   g.x0 = spec.x0;
   g.y0 = spec.y0;
   g.z0 = spec.z0;
+  return g;
+}
+
+Problem make_problem(const ProblemSpec& spec) {
+  validate(spec);
+  Problem P;
+  P.spec = spec;
+  P.grid = grid_of(spec);
+  const GridDims& g = P.grid;
   const index N = g.nodes();
   P.load.assign(3 * N, 0.0);
   // surface tractions: face f's quads, each node of a quad gets area/4

@@ -80,6 +80,13 @@ ProblemSpec spec_for_dims(index ex, index ey, index ez);
 // Throws std::invalid_argument naming the offending value.
 void validate(const ProblemSpec& s);
 
+// Contact node c = (ix - 1) + ex iy, 1 <= ix <= ex, on the bottom face:
+// its grid node and its position (x, y)
+inline index contact_grid_node(const GridDims& g, index c) { return g.node(1 + c % g.ex, c / g.ex, 0); }
+inline std::array<real, 2> contact_position(const GridDims& g, index c) {
+  return {g.x0 + real(1 + c % g.ex) * g.hx(), g.y0 + real(c / g.ex) * g.hy()};
+}
+
 struct Problem {
   ProblemSpec spec;
   GridDims grid;
@@ -88,7 +95,7 @@ struct Problem {
   std::vector<real> load;                          // l, SoA, 3N
   index contact_nodes() const { return spec.contact_nodes(); }
   // grid node of contact node c
-  index contact_grid_node(index c) const { return grid.node(1 + c % grid.ex, c / grid.ex, 0); }
+  index contact_grid_node(index c) const { return tresca::contact_grid_node(grid, c); }
   index nodes() const { return grid.nodes(); }
   index dofs() const { return 3 * grid.nodes(); }
   // unknown displacement dofs (all but the Dirichlet face)
@@ -96,6 +103,8 @@ struct Problem {
 };
 
 Problem make_problem(const ProblemSpec& spec);
+// the mesh of a problem, without building it (no load vector)
+GridDims grid_of(const ProblemSpec& spec);
 
 // Rough peak memory of a full tresca solve in bytes (for a warning before large runs).
 double estimated_memory_bytes(const ProblemSpec& s);

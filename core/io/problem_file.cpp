@@ -180,7 +180,7 @@ ProblemFile read_problem_file(const std::string& path) {
   return parse_problem(os.str(), "problem file '" + path + "'");
 }
 
-std::vector<real> read_gap_csv(const std::string& path, const Problem& P) {
+std::vector<real> read_gap_csv(const std::string& path, const GridDims& g) {
   std::ifstream in(path);
   if (!in) throw std::invalid_argument("cannot read gap file '" + path + "'");
   auto fail = [&](long line, const std::string& what) {
@@ -189,8 +189,7 @@ std::vector<real> read_gap_csv(const std::string& path, const Problem& P) {
   std::string row;
   long line = 1;
   if (!std::getline(in, row) || row.substr(0, 9) != "ix,iy,gap") fail(1, "the header must be 'ix,iy,gap'");
-  const GridDims& g = P.grid;
-  const index p = P.contact_nodes();
+  const index p = g.ex * g.ny();
   std::vector<real> gap(p, -1);
   index seen = 0;
   while (std::getline(in, row)) {

@@ -39,7 +39,7 @@ ProblemFile parse_problem(const std::string& text, const std::string& origin = "
 // Gaps per contact node from a CSV file with the header `ix,iy,gap` and one
 // row per contact node (1 <= ix <= ex, 0 <= iy <= ey; gap >= 0 in metres),
 // every contact node exactly once; throws with the file, line and value.
-std::vector<real> read_gap_csv(const std::string& path, const Problem& P);
+std::vector<real> read_gap_csv(const std::string& path, const GridDims& g);
 // the problem in the file's schema, as JSON text (one line)
 std::string problem_json(const ProblemSpec& s, real coulomb);
 
