@@ -88,9 +88,10 @@ bool linearise(index p, const ContactConditions& law, const real* scale, const s
   return any_known;
 }
 
-// y = mask_F (S x + H x), with S x as the side product (the Newton update
-// reuses it: S u += S Δu without another application of S). The inner
-// tolerance is this step's own state, relaxed as its outer CG converges.
+// y = mask_F (S x + H x), with S x as the side product: the CG's running
+// S Δu, whose norm sets the accuracy of the bookkeeping apply of S Δu (step
+// 4). The inner tolerance is this step's own state, relaxed as its outer CG
+// converges.
 class ReducedNewtonOperator : public LinearOperatorWithSide {
  public:
   ReducedNewtonOperator(const SteklovPoincare& S, const ReducedSystem& L, InnerWork& work)

@@ -52,6 +52,35 @@ void unregister_live(const std::string& tmp) {
     }
 }
 
+// What an output path is: refused (why), a special file (FIFO, device) to be
+// written in place, or a regular file, existing or not, to be replaced
+// through a temporary. One classification for the early check and the writer.
+struct OutputTarget {
+  std::string refused;  // non-empty: not writable as an output, and why
+  bool special = false, exists = false;
+  mode_t mode = 0;  // an existing file's permissions
+};
+OutputTarget output_target(const std::string& path) {
+  OutputTarget t;
+  if (path.empty() || path.back() == '/') {
+    t.refused = "is not a file name";
+    return t;
+  }
+  struct stat st;
+  t.exists = ::stat(path.c_str(), &st) == 0;
+  if (t.exists && S_ISDIR(st.st_mode)) t.refused = "is a directory";
+  t.special = t.exists && !S_ISDIR(st.st_mode) && !S_ISREG(st.st_mode);
+  if (t.exists) t.mode = st.st_mode & 07777;
+  return t;
+}
+
+// a fresh temporary next to `path` (mkstemp: exclusive, never a symlink);
+// its name in tmp, its descriptor returned, < 0 if it cannot be made
+int make_temporary(const std::string& path, std::string& tmp) {
+  tmp = path + ".XXXXXX";
+  return ::mkstemp(&tmp[0]);
+}
+
 }  // namespace
 
 // One output file, written safely (issue 11):
@@ -66,26 +95,21 @@ void unregister_live(const std::string& tmp) {
 class OutputFile {
  public:
   explicit OutputFile(const std::string& path) : path_(path) {
-    if (path.empty() || path.back() == '/') throw std::runtime_error("cannot write '" + path + "': not a file name");
-    struct stat st;
-    const bool exists = ::stat(path.c_str(), &st) == 0;
-    if (exists && S_ISDIR(st.st_mode)) throw std::runtime_error("cannot write '" + path + "': it is a directory");
-    if (exists && !S_ISREG(st.st_mode)) {
+    const OutputTarget t = output_target(path);
+    if (!t.refused.empty()) throw std::runtime_error("cannot write '" + path + "': it " + t.refused);
+    if (t.special) {
       f_ = std::fopen(path.c_str(), "wb");
       if (!f_) throw std::runtime_error("cannot write '" + path + "'");
       return;
     }
-    tmp_ = path + ".XXXXXX";
-    const int fd = ::mkstemp(&tmp_[0]);
+    const int fd = make_temporary(path, tmp_);
     if (fd < 0) {
       tmp_.clear();
       throw std::runtime_error("cannot write '" + path + "'");
     }
     register_live(tmp_);
-    mode_t mode;
-    if (exists) {
-      mode = st.st_mode & 07777;
-    } else {
+    mode_t mode = t.mode;
+    if (!t.exists) {
       const mode_t mask = ::umask(0);
       ::umask(mask);
       mode = 0666 & ~mask;
@@ -169,18 +193,15 @@ bool same_file(const std::string& a, const std::string& b) {
 }
 
 void check_writable(const std::string& path) {
-  if (path.empty() || path.back() == '/') throw std::invalid_argument("output file '" + path + "' is not a file name");
-  struct stat st;
-  if (::stat(path.c_str(), &st) == 0) {
-    if (S_ISDIR(st.st_mode)) throw std::invalid_argument("output file '" + path + "' is a directory");
-    if (!S_ISREG(st.st_mode)) {  // written in place: it must be writable
-      if (::access(path.c_str(), W_OK) != 0) throw std::invalid_argument("cannot write output file '" + path + "'");
-      return;
-    }
+  const OutputTarget t = output_target(path);
+  if (!t.refused.empty()) throw std::invalid_argument("output file '" + path + "' " + t.refused);
+  if (t.special) {  // written in place: it must be writable (opening a FIFO here would block)
+    if (::access(path.c_str(), W_OK) != 0) throw std::invalid_argument("cannot write output file '" + path + "'");
+    return;
   }
   // a temporary next to it, as the writer will make
-  std::string tmp = path + ".XXXXXX";
-  const int fd = ::mkstemp(&tmp[0]);
+  std::string tmp;
+  const int fd = make_temporary(path, tmp);
   if (fd < 0) throw std::invalid_argument("cannot write output file '" + path + "'");
   ::close(fd);
   ::unlink(tmp.c_str());
