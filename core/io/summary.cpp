@@ -8,6 +8,12 @@
 
 namespace tresca {
 
+namespace {
+std::string dims_json(const ProblemSpec& s) {
+  return "[" + std::to_string(s.ex) + ", " + std::to_string(s.ey) + ", " + std::to_string(s.ez) + "]";
+}
+}  // namespace
+
 Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const RunOptions& opt) {
   const double eps = opt.newton.eps;
   const Problem& P = *R.problem;
@@ -30,7 +36,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   std::string nested = "[";
   for (const NestedLevel& l : R.nested) {
     Json n;
-    n.raw("dims", "[" + std::to_string(l.spec.ex) + ", " + std::to_string(l.spec.ey) + ", " + std::to_string(l.spec.ez) + "]")
+    n.raw("dims", dims_json(l.spec))
         .integer("newton_iterations", l.newton_iterations).boolean("converged", l.converged)
         .num("fine_matvecs_own", l.fine_matvecs).num("seconds", l.seconds);
     nested += (nested.size() > 1 ? ", " : "") + n.render();
@@ -60,7 +66,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
     j.integer("level", spec.level);
   else
     j.null("level");
-  j.raw("dims", "[" + std::to_string(spec.ex) + ", " + std::to_string(spec.ey) + ", " + std::to_string(spec.ez) + "]")
+  j.raw("dims", dims_json(spec))
       .integer("nodes", P.nodes()).integer("contact_nodes", P.contact_nodes()).integer("dofs", P.free_dofs())
       .str("friction", R.coulomb ? "coulomb" : "tresca")
       .num("phi", R.coulomb ? NAN : spec.phi).num("gap", spec.obstacle.gap).raw("obstacle", obstacle.render()).num("load_scale", spec.load_scale).num("eps", eps).integer("threads", threads).str("build", build_info())
