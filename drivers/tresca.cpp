@@ -14,6 +14,7 @@
 #include "core/io/output.hpp"
 #include "core/io/problem_file.hpp"
 #include "core/io/summary.hpp"
+#include "core/io/vtu.hpp"
 #include "core/util/profile.hpp"
 #include "core/contact/run.hpp"
 #include "kernels/simd.hpp"
@@ -55,7 +56,11 @@ const char* kHelp =
     "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
     "  --json FILE        write the run summary as one JSON object (rows with --table)\n"
     "  --contact-csv FILE one row per contact node\n"
-    "  --vtk FILE.vtu     deformed body for ParaView (+ FILE_contact.vtu)\n"
+    "  --vtk FILE.vtu     deformed body for ParaView (+ FILE_contact.vtu); with --table one pair\n"
+    "                     FILE_levelL.vtu, FILE_levelL_contact.vtu per level and FILE.pvd to play them\n"
+    "  --vtk-every-iteration  with --vtk: also FILE_itK.vtu (+ _contact) at every Newton iterate K\n"
+    "                     of the fine mesh and FILE.pvd to play them in ParaView (one extra S apply each)\n"
+    "  --vtk-format binary|ascii  VTU encoding: zlib-compressed appended binary (default) or text\n"
     "  --table A-B        solve levels A..B and print the paper's Table 1 columns\n"
     "  --profile          per-kernel time, GB/s and GFLOP/s after the run\n"
     "  --quiet            no progress lines\n"
@@ -89,20 +94,23 @@ int main(int argc, char** argv) {
   RunOptions opt;
   int threads = 1;
   std::string json_path, csv_path, vtk_path, table;
+  std::vector<int> table_levels;
+  VtkFormat vtk_format = VtkFormat::binary;
+  bool every_iteration = false;
   bool quiet = false, profile = false;
   try {
     const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem", "--gap-file"},
-                  {"--quiet", "--help", "--profile", "--no-nested"});
+                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem", "--gap-file", "--vtk-format"},
+                  {"--quiet", "--help", "--profile", "--no-nested", "--vtk-every-iteration"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
       return 0;
     }
     threads = apply_threads(a);
     table = a.str("--table");
-    if (!table.empty() && (a.has("--level") || a.has("--dims") || a.has("--vtk") || a.has("--contact-csv")))
-      throw std::invalid_argument("--table runs its own levels; it takes no --level/--dims/--vtk/--contact-csv");
+    if (!table.empty() && (a.has("--level") || a.has("--dims") || a.has("--contact-csv")))
+      throw std::invalid_argument("--table runs its own levels; it takes no --level/--dims/--contact-csv");
     ProblemFile file;
     if (a.has("--problem")) {
       if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's problem; it takes no --problem");
@@ -154,13 +162,30 @@ int main(int argc, char** argv) {
     json_path = a.str("--json");
     csv_path = a.str("--contact-csv");
     vtk_path = a.str("--vtk");
+    vtk_format = parse_vtk_format(a.str("--vtk-format", "binary"), "--vtk-format");
+    if (!table.empty()) table_levels = parse_level_range(table);
     // every output, the derived <stem>_contact.vtu included, checked before the solve
     std::vector<std::pair<std::string, std::string>> outputs;  // (path, what)
     if (!json_path.empty()) outputs.push_back({json_path, "--json"});
     if (!csv_path.empty()) outputs.push_back({csv_path, "--contact-csv"});
-    if (!vtk_path.empty()) {
+    if (!vtk_path.empty() && table.empty()) {
       outputs.push_back({vtk_path, "--vtk"});
       outputs.push_back({vtu_companion(vtk_path), "--vtk's contact file"});
+    }
+    every_iteration = a.has("--vtk-every-iteration");
+    if (every_iteration && (vtk_path.empty() || !table.empty()))
+      throw std::invalid_argument("--vtk-every-iteration needs --vtk FILE.vtu (and no --table)");
+    if (every_iteration) {
+      outputs.push_back({pvd_name(vtk_path), "--vtk's collection"});
+      outputs.push_back({vtu_step_name(vtk_path, "_it0"), "--vtk's iterates"});
+    }
+    if (!vtk_path.empty() && !table.empty()) {
+      outputs.push_back({pvd_name(vtk_path), "--vtk's collection"});
+      for (int L : table_levels) {
+        const std::string v = vtu_step_name(vtk_path, "_level" + std::to_string(L));
+        outputs.push_back({v, "--vtk's level " + std::to_string(L)});
+        outputs.push_back({vtu_companion(v), "--vtk's level " + std::to_string(L) + " contact file"});
+      }
     }
     for (size_t i = 0; i < outputs.size(); ++i) {
       check_writable(outputs[i].first);
@@ -199,8 +224,10 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       };
     if (!table.empty()) {
-      const std::vector<int> levels = parse_level_range(table);
+      const std::vector<int>& levels = table_levels;
       for (int L : levels) check_memory(spec_for_level(L));
+      OutputSet out;  // the levels' VTU files and the collection, published with the JSON
+      std::vector<PvdStep> steps;
       std::printf("%5s %9s %9s %9s %7s %9s %5s %5s | paper: %9s %9s %9s %5s | %s\n", "level", "n", "setup", "condense",
                   "p", "solve", "iters", "conv", "assembly", "schur", "solver", "iters", "true residual (rel)");
       std::string rows = "[";
@@ -213,8 +240,14 @@ int main(int argc, char** argv) {
         RunOptions o = opt;
         o.newton.progress = nullptr;
         o.phase_done = nullptr;
-        o.recover_interior = false;
+        o.recover_interior = !vtk_path.empty();
         const RunResult R = run_tresca(s, o);
+        if (!vtk_path.empty()) {
+          const std::string v = vtu_step_name(vtk_path, "_level" + std::to_string(L));
+          const ContactFields cf{&R.newton.u, &R.newton.lambda, &R.report.r, &R.report.status, &R.contact.phi,
+                                 &R.contact.gap};
+          steps.push_back({double(L), {v, write_vtu(out, v, *R.problem, R.u_full, cf, vtk_format)}});
+        }
         const PaperRow* pr = paper_row(L);
         char pbuf[128] = "        -         -         -     -";
         if (pr) std::snprintf(pbuf, sizeof pbuf, "%9.3f %9.3f %9.3f %5d", pr->assembly, pr->schur, pr->solver, pr->iters);
@@ -226,7 +259,15 @@ int main(int argc, char** argv) {
         all = all && R.converged();
         rows += (rows.size() > 1 ? ",\n " : "") + run_summary(s, R, threads, opt).render();
       }
-      if (!json_path.empty()) write_file_atomic(json_path, rows + "]\n");
+      try {
+        if (!json_path.empty()) write_text(out, json_path, rows + "]\n");
+        if (!vtk_path.empty()) write_pvd(out, pvd_name(vtk_path), steps);
+        out.publish();
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "tresca: error: %s\n", e.what());
+        return 3;
+      }
+      if (!vtk_path.empty() && !quiet) std::printf("wrote %s (levels %d-%d)\n", pvd_name(vtk_path).c_str(), levels.front(), levels.back());
       return all ? 0 : 1;
     }
 
@@ -243,6 +284,17 @@ int main(int argc, char** argv) {
       std::printf("        estimated peak memory %.2f GB; kernels: %s\n", estimated_memory_bytes(spec) / 1e9,
                   build_info().c_str());
     }
+    // --vtk-every-iteration: the iterates' files, published with the run's others
+    OutputSet out;
+    std::vector<PvdStep> steps;
+    if (every_iteration)
+      opt.iterate_done = [&](const Iterate& it) {
+        const NewtonProgress& pr = *it.progress;
+        const ContactFields cf{pr.u, pr.lambda, pr.r, pr.status, pr.phi, it.gap};
+        const std::string v = vtu_step_name(vtk_path, "_it" + std::to_string(it.step));
+        steps.push_back({double(it.step), {v, write_vtu(out, v, *it.problem, *it.u_full, cf, vtk_format)}});
+        out.finish();
+      };
     const RunResult R = run_tresca(spec, opt);
     const NewtonResult& N = R.newton;
     const FinalReport& F = R.report;
@@ -290,11 +342,11 @@ int main(int argc, char** argv) {
     try {
       const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.contact.phi, &R.contact.gap};
       // all of the run's outputs, or none of them (output.hpp: OutputSet)
-      OutputSet out;
+      if (every_iteration) write_pvd(out, pvd_name(vtk_path), steps);
       if (!json_path.empty()) write_text(out, json_path, run_summary(spec, R, threads, opt).render() + "\n");
       if (!csv_path.empty()) write_contact_csv(out, csv_path, *R.problem, cf);
       std::string second;
-      if (!vtk_path.empty()) second = write_vtu(out, vtk_path, *R.problem, R.u_full, cf);
+      if (!vtk_path.empty()) second = write_vtu(out, vtk_path, *R.problem, R.u_full, cf, vtk_format);
       out.publish();
       if (!vtk_path.empty() && !quiet) std::printf("wrote %s and %s\n", vtk_path.c_str(), second.c_str());
     } catch (const std::exception& e) {

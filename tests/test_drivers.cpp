@@ -105,6 +105,9 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --level 2 --json --quiet", "not the option '--quiet'");
   expect_error("tresca --table ''", "empty");
   expect_error("tresca --dims 4x2x2 --max-newton 0", "--max-newton 0");
+  expect_error("tresca --dims 4x2x2 --vtk o.vtu --vtk-format xml", "--vtk-format 'xml' must be binary or ascii");
+  expect_error("tresca --dims 4x2x2 --vtk-every-iteration", "needs --vtk");
+  expect_error("tresca --table 1-2 --vtk-every-iteration --vtk o.vtu", "needs --vtk");
   // messages say the value as given, and not 100 KB of it
   expect_error("tresca --dims 4x2x2 --nu 0.5", "nu = 0.5 ");
   expect_error("tresca --dims 4x2x2 --nu 0.50000001", "0.50000001");

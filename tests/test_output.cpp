@@ -15,6 +15,7 @@
 #include "core/contact/run.hpp"
 #include "core/io/output.hpp"
 #include "core/io/summary.hpp"
+#include "core/io/vtu.hpp"
 #include "kernels/contact_maps.hpp"
 
 namespace tresca {
@@ -148,7 +149,7 @@ TEST_F(OutputFiles, AnUnpublishedSetLeavesNothing) {
 TEST_F(OutputFiles, VtuHoldsTheSolversFieldsOnPositiveVolumeHexahedra) {
   const std::string path = ::testing::TempDir() + "tresca_out.vtu";
   OutputSet out;
-  const std::string cpath = write_vtu(out, path, *R_->problem, R_->u_full, fields());
+  const std::string cpath = write_vtu(out, path, *R_->problem, R_->u_full, fields(), VtkFormat::ascii);
   out.publish();
   EXPECT_EQ(cpath, ::testing::TempDir() + "tresca_out_contact.vtu");
   const Problem& P = *R_->problem;

@@ -37,6 +37,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     RunOptions co = opt;
     co.recover_interior = true;
     co.newton.progress = nullptr;
+    co.iterate_done = nullptr;
     co.phase_done = nullptr;  // one line per coarse mesh: nested_done
     co.newton.rtol = opt.nested_rtol;
     co.coulomb_tol = std::max(opt.coulomb_tol, opt.nested_rtol);
@@ -68,6 +69,16 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   SteklovPoincare S(*R.problem, opt.mg);
   const double t1 = wall_time();
   if (opt.phase_done) opt.phase_done("setup (mesh, operators, multigrid)", t1 - t0s);
+  if (opt.iterate_done) {
+    // each iterate's body: E u from one S apply, plus K_ii^{-1} l_i
+    newton.progress = [&, shown = newton.progress, step = 0](const NewtonProgress& pr) mutable {
+      if (shown) shown(pr);
+      std::vector<real> Su(pr.u->size()), u_full(3 * size_t(S.problem().nodes()));
+      S.apply(pr.u->data(), Su.data(), 1e-8, u_full.data());
+      axpy(index(u_full.size()), 1, R.interior_load.data(), u_full.data());
+      opt.iterate_done(Iterate{R.problem.get(), step++, &pr, &u_full, &R.contact.gap});
+    };
+  }
   std::vector<real> btilde;
   const SolveStats cond = S.condensed_load(opt.tight_rtol, btilde, &R.interior_load,
                                            load_guess.empty() ? nullptr : load_guess.data());

@@ -24,6 +24,16 @@ struct NestedLevel {
   double seconds = 0;       // its own time (without coarser meshes)
 };
 
+// One Newton iterate of the fine mesh with the body's displacement, for
+// output (RunOptions::iterate_done); pointers valid during the call.
+struct Iterate {
+  const Problem* problem;
+  int step;  // 0, 1, ... over the run (a Coulomb fixed point's Tresca solves continue it)
+  const NewtonProgress* progress;
+  const std::vector<real>* u_full;  // 3N SoA: E u + K_ii^{-1} l_i
+  const std::vector<real>* gap;     // p
+};
+
 struct RunOptions {
   NewtonOptions newton;
   MGOptions mg;  // both V-cycles: the inner K_ii solve and the Newton-step preconditioner
@@ -32,6 +42,10 @@ struct RunOptions {
   // called after each coarse mesh of nested iteration, coarsest first
   std::function<void(const NestedLevel&)> nested_done;
   bool recover_interior = true;  // full 3D displacement (needed for VTK output)
+  // called at every Newton iterate of the fine mesh with the body's
+  // displacement (one extra S apply per iterate, to 1e-8, not counted as
+  // solver work); for output such as --vtk-every-iteration
+  std::function<void(const Iterate&)> iterate_done;
   // nested iteration (nested.hpp): coarser meshes first, down to meshes of
   // at least nested_min_contact_nodes contact nodes; off: x0 = 0 (the paper)
   bool nested = true;

@@ -278,7 +278,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     R.inner_history.push_back(work.iterations);
     R.outer_history.push_back(R.outer_iterations);
     if (opt.progress) {
-      NewtonProgress pr{k, vnorm, 0, 0, 0, 0, work.iterations, R.outer_iterations, wall_time() - t0};
+      NewtonProgress pr{k, vnorm, 0, 0, 0, 0, work.iterations, R.outer_iterations, wall_time() - t0,
+                        &R.u, &R.lambda, &r, &R.status, &law.phi};
       for (index i = 0; i < p; ++i) {
         (R.status[i] & kContact ? pr.active : pr.separated) += 1;
         (R.status[i] & kStick ? pr.sticking : pr.sliding) += 1;

@@ -50,6 +50,13 @@ struct NewtonProgress {
   index active, separated, sticking, sliding;
   long long inner_iterations, outer_iterations;  // cumulative
   double elapsed;
+  // the iterate itself, valid during the call: u (3p), lambda (p), the
+  // contact forces r = S u - b̃ (3p), status and bound of this step (p)
+  const std::vector<real>* u = nullptr;
+  const std::vector<real>* lambda = nullptr;
+  const std::vector<real>* r = nullptr;
+  const std::vector<std::uint8_t>* status = nullptr;
+  const std::vector<real>* phi = nullptr;
 };
 
 enum class OuterPreconditioner { multigrid, none };

@@ -19,7 +19,7 @@ namespace tresca {
 namespace {
 // Temporaries alive right now, removed by SIGINT / SIGTERM / SIGHUP before
 // the signal takes its default course (unlink is async-signal-safe).
-constexpr int kMaxLive = 64;
+constexpr int kMaxLive = 4096;
 char* g_live[kMaxLive];
 volatile std::sig_atomic_t g_handlers_installed = 0;
 
@@ -133,6 +133,7 @@ class OutputFile {
   std::FILE* get() const { return f_; }
   // all data on disk and the file closed; throws if any write failed
   void finish() {
+    if (!f_) return;  // finished before
     bool ok = std::fflush(f_) == 0 && !std::ferror(f_);
     if (ok && !tmp_.empty()) ok = ::fsync(::fileno(f_)) == 0;
     ok = std::fclose(f_) == 0 && ok;
@@ -161,6 +162,10 @@ std::FILE* OutputSet::create(const std::string& path) {
   return files_.back()->get();
 }
 
+void OutputSet::finish() {
+  for (auto& f : files_) f->finish();
+}
+
 void OutputSet::publish() {
   for (auto& f : files_) f->finish();  // every file complete on disk first
   for (auto& f : files_) f->publish();
@@ -175,16 +180,30 @@ struct OutputHandle {
   std::FILE* get() const { return f; }
 };
 
-std::string stem_of(const std::string& path) {
+}  // namespace
+
+std::string path_stem(const std::string& path) {
   const auto slash = path.find_last_of('/');
   const auto dot = path.find_last_of('.');
   return (dot != std::string::npos && (slash == std::string::npos || dot > slash)) ? path.substr(0, dot) : path;
 }
 
-int status_code(std::uint8_t s) { return (s & kContact) ? ((s & kStick) ? 2 : 3) : 1; }
-}  // namespace
+std::string xml_escaped(const std::string& s) {
+  std::string e;
+  for (char c : s) {
+    switch (c) {
+      case '&': e += "&amp;"; break;
+      case '<': e += "&lt;"; break;
+      case '>': e += "&gt;"; break;
+      case '"': e += "&quot;"; break;
+      case '\'': e += "&apos;"; break;
+      default: e += c;
+    }
+  }
+  return e;
+}
 
-std::string vtu_companion(const std::string& vtu_path) { return stem_of(vtu_path) + "_contact.vtu"; }
+std::string vtu_companion(const std::string& vtu_path) { return path_stem(vtu_path) + "_contact.vtu"; }
 
 bool same_file(const std::string& a, const std::string& b) {
   std::error_code ea, eb;
@@ -278,90 +297,6 @@ void write_contact_csv(OutputSet& out, const std::string& path, const Problem& P
                  (long long)iy, g.x0 + ix * g.hx(), g.y0 + iy * g.hy(), (*c.u)[i], (*c.u)[p + i], (*c.u)[2 * p + i],
                  (*c.lambda)[i], (*c.phi)[i], (*c.gap)[i], (s & kContact) ? 1 : 0, (s & kStick) ? 1 : 0);
   }
-}
-
-namespace {
-void vtu_header(std::FILE* f, index points, index cells) {
-  std::fprintf(f,
-               "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
-               "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"%lld\" "
-               "NumberOfCells=\"%lld\">\n",
-               (long long)points, (long long)cells);
-}
-void vtu_cells(std::FILE* f, const std::vector<index>& conn, int per_cell, int vtk_type) {
-  const index cells = index(conn.size()) / per_cell;
-  std::fprintf(f, "<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
-  for (index i = 0; i < index(conn.size()); ++i) std::fprintf(f, "%lld%c", (long long)conn[i], (i + 1) % per_cell ? ' ' : '\n');
-  std::fprintf(f, "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
-  for (index c = 0; c < cells; ++c) std::fprintf(f, "%lld\n", (long long)(per_cell * (c + 1)));
-  std::fprintf(f, "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-  for (index c = 0; c < cells; ++c) std::fprintf(f, "%d\n", vtk_type);
-  std::fprintf(f, "</DataArray>\n</Cells>\n");
-}
-}  // namespace
-
-std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
-                      const ContactFields& c) {
-  const GridDims& g = P.grid;
-  const index N = g.nodes(), p = P.contact_nodes(), M = g.nx() * g.ny();
-  // per grid node: contact node id or -1
-  std::vector<index> cid(M, -1);
-  for (index i = 0; i < p; ++i) cid[P.contact_grid_node(i)] = i;
-  {
-    OutputHandle f{out.create(path)};
-    vtu_header(f.get(), N, g.ex * g.ey * g.ez);
-    std::fprintf(f.get(), "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for (index iz = 0; iz < g.nz(); ++iz)
-      for (index iy = 0; iy < g.ny(); ++iy)
-        for (index ix = 0; ix < g.nx(); ++ix)
-          std::fprintf(f.get(), "%.9g %.9g %.9g\n", g.x0 + ix * g.hx(), g.y0 + iy * g.hy(), g.z0 + iz * g.hz());
-    std::fprintf(f.get(), "</DataArray>\n</Points>\n");
-    std::vector<index> conn;
-    conn.reserve(size_t(8 * g.ex * g.ey * g.ez));
-    const int order[8] = {0, 1, 3, 2, 4, 5, 7, 6};  // VTK_HEXAHEDRON node order
-    for (index ez = 0; ez < g.ez; ++ez)
-      for (index ey = 0; ey < g.ey; ++ey)
-        for (index ex = 0; ex < g.ex; ++ex)
-          for (int k : order) conn.push_back(g.node(ex + (k & 1), ey + ((k >> 1) & 1), ez + ((k >> 2) & 1)));
-    vtu_cells(f.get(), conn, 8, 12);
-    std::fprintf(f.get(), "<PointData Vectors=\"displacement\">\n");
-    std::fprintf(f.get(), "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for (index n = 0; n < N; ++n) std::fprintf(f.get(), "%.12g %.12g %.12g\n", u_full[n], u_full[N + n], u_full[2 * N + n]);
-    std::fprintf(f.get(), "</DataArray>\n<DataArray type=\"Float64\" Name=\"contact_force\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for (index n = 0; n < N; ++n) {
-      const index i = n < M ? cid[n] : -1;
-      if (i < 0)
-        std::fprintf(f.get(), "0 0 0\n");
-      else
-        std::fprintf(f.get(), "%.12g %.12g %.12g\n", (*c.r)[i], (*c.r)[p + i], (*c.lambda)[i]);
-    }
-    std::fprintf(f.get(), "</DataArray>\n<DataArray type=\"UInt8\" Name=\"contact_status\" format=\"ascii\">\n");
-    for (index n = 0; n < N; ++n) {
-      const index i = n < M ? cid[n] : -1;
-      std::fprintf(f.get(), "%d\n", i < 0 ? 0 : status_code((*c.status)[i]));
-    }
-    std::fprintf(f.get(), "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-  }
-  // contact face: the bottom plane as quads, its own point numbering
-  const std::string cpath = vtu_companion(path);
-  OutputHandle f{out.create(cpath)};
-  vtu_header(f.get(), M, g.ex * g.ey);
-  std::fprintf(f.get(), "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-  for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%.9g %.9g %.9g\n", g.x0 + (n % g.nx()) * g.hx(), g.y0 + (n / g.nx()) * g.hy(), g.z0);
-  std::fprintf(f.get(), "</DataArray>\n</Points>\n");
-  std::vector<index> conn;
-  for (index ey = 0; ey < g.ey; ++ey)
-    for (index ex = 0; ex < g.ex; ++ex)
-      for (index k : {index(0), index(1), g.nx() + 1, g.nx()}) conn.push_back(ex + g.nx() * ey + k);
-  vtu_cells(f.get(), conn, 4, 9);
-  std::fprintf(f.get(), "<PointData Vectors=\"displacement\">\n<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-  for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%.12g %.12g %.12g\n", u_full[n], u_full[N + n], u_full[2 * N + n]);
-  std::fprintf(f.get(), "</DataArray>\n<DataArray type=\"Float64\" Name=\"lambda\" format=\"ascii\">\n");
-  for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%.12g\n", cid[n] < 0 ? 0.0 : (*c.lambda)[cid[n]]);
-  std::fprintf(f.get(), "</DataArray>\n<DataArray type=\"UInt8\" Name=\"contact_status\" format=\"ascii\">\n");
-  for (index n = 0; n < M; ++n) std::fprintf(f.get(), "%d\n", cid[n] < 0 ? 0 : status_code((*c.status)[cid[n]]));
-  std::fprintf(f.get(), "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-  return cpath;
 }
 
 }  // namespace tresca

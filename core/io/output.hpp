@@ -17,6 +17,10 @@ namespace tresca {
 
 // Throws if `path` cannot be created (checked before a long run starts).
 void check_writable(const std::string& path);
+// "dir/name" for "dir/name.ext" (the path itself without an extension)
+std::string path_stem(const std::string& path);
+// s with XML's five special characters as entities (for attribute values)
+std::string xml_escaped(const std::string& s);
 // the contact-face file written next to a body VTU: "<stem>_contact.vtu"
 std::string vtu_companion(const std::string& vtu_path);
 // whether two output paths name the same file (also through "..", "." or
@@ -34,6 +38,9 @@ class OutputSet {
   OutputSet();
   ~OutputSet();
   std::FILE* create(const std::string& path);  // stays owned by the set
+  // the files created so far complete on disk and closed (no longer
+  // writable), still unpublished: for sets of many files
+  void finish();
   void publish();
 
  private:
@@ -70,11 +77,5 @@ struct ContactFields {
 };
 
 void write_contact_csv(OutputSet& out, const std::string& path, const Problem& P, const ContactFields& c);
-// Body as VTK XML unstructured grid (hexahedra) with point data displacement,
-// contact_force and contact_status (0 not a contact node, 1 separated,
-// 2 contact+stick, 3 contact+slip); the contact face (quads) goes to
-// "<stem>_contact.vtu" next to it. Returns the second file's path.
-std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
-                      const ContactFields& c);
 
 }  // namespace tresca

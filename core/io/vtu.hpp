@@ -1,0 +1,46 @@
+// VTK XML output for ParaView: the body as an unstructured grid of
+// hexahedra, the contact face as quads, and .pvd collections that play a
+// sequence of them (the levels of --table, the iterates of a Newton solve).
+//
+// Binary (the default) is VTK's appended raw encoding compressed with LZMA
+// (compressor="vtkLZMADataCompressor", header_type="UInt64"; ParaView reads
+// it since 5.5): every array is a header [blocks, block size, size of a
+// partial last block (0: full), compressed size of each block] followed by
+// the blocks, each one .xz stream, compressed in parallel. Values are the
+// solver's doubles exactly.
+// ASCII writes the same arrays as text (12 significant digits).
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/io/output.hpp"
+
+namespace tresca {
+
+enum class VtkFormat { binary, ascii };
+// "binary" or "ascii"; throws std::invalid_argument naming `option` otherwise
+VtkFormat parse_vtk_format(const std::string& s, const std::string& option);
+
+// Body with point data displacement, contact_force and contact_status
+// (0 not a contact node, 1 separated, 2 contact+stick, 3 contact+slip); the
+// contact face (quads, with displacement, lambda and contact_status) goes to
+// vtu_companion(path). Returns the second file's path.
+std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
+                      const ContactFields& c, VtkFormat format = VtkFormat::binary);
+
+// A ParaView collection: each (time, file) is one step; a step's files are
+// its parts (here the body and its contact face). `files` are written
+// relative to the .pvd's directory.
+struct PvdStep {
+  double time;
+  std::vector<std::string> files;
+};
+void write_pvd(OutputSet& out, const std::string& path, const std::vector<PvdStep>& steps);
+
+// "<stem><suffix>.vtu" for "<stem>.vtu": the name of one step of a sequence
+std::string vtu_step_name(const std::string& vtu_path, const std::string& suffix);
+// "<stem>.pvd" for "<stem>.vtu"
+std::string pvd_name(const std::string& vtu_path);
+
+}  // namespace tresca

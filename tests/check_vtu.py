@@ -1,0 +1,150 @@
+#!/usr/bin/env python3
+"""Reads the driver's VTU files with VTK itself (ParaView's reader library,
+Debian python3-vtk9) and checks them against the run's contact CSV and JSON:
+
+  check_vtu.py --vtu B.vtu --csv C.csv --json J.json [--ascii A.vtu --min-ratio R]
+  check_vtu.py --pvd P.pvd --steps N
+  check_vtu.py --pvd P.pvd --json J.json      (a --vtk-every-iteration run)
+
+- the body: (ex+1)(ey+1)(ez+1) points, ex*ey*ez hexahedra of positive volume
+  (every cell is checked in vectorised form), its bottom plane's displacement
+  equal to the contact file's;
+- the contact file: displacement and lambda of every contact node equal to
+  the CSV's (printed with 17 digits, so equal to the last bit up to one
+  rounding), contact_status equal to the CSV's contact/stick columns;
+- --ascii: the same run written as text holds the same arrays (to its 12
+  digits), and the binary files are at least R times smaller;
+- --pvd: a collection of N steps, the body and its contact face each, all
+  files read by VTK.
+Exits 1 with the first failed check on stderr."""
+import argparse
+import csv
+import json
+import os
+import sys
+
+import numpy as np
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
+
+
+def fail(msg):
+    print("check_vtu: FAILED: " + msg, file=sys.stderr)
+    sys.exit(1)
+
+
+def read(path):
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(path)
+    r.Update()
+    g = r.GetOutput()
+    if r.GetErrorCode() != 0 or g is None or g.GetNumberOfPoints() == 0:
+        fail(path + ": VTK could not read it")
+    return g
+
+
+def arrays(g):
+    out = {"points": vtk_to_numpy(g.GetPoints().GetData()),
+           "connectivity": vtk_to_numpy(g.GetCells().GetConnectivityArray()),
+           "types": vtk_to_numpy(g.GetCellTypesArray())}
+    pd = g.GetPointData()
+    for i in range(pd.GetNumberOfArrays()):
+        out[pd.GetArrayName(i)] = vtk_to_numpy(pd.GetArray(i))
+    return out
+
+
+def companion(path):
+    return os.path.splitext(path)[0] + "_contact.vtu"
+
+
+def check_run(args):
+    with open(args.json) as f:
+        run = json.load(f)
+    ex, ey, ez = run["dims"]
+    body, face = arrays(read(args.vtu)), arrays(read(companion(args.vtu)))
+    nx, ny, nz = ex + 1, ey + 1, ez + 1
+    if len(body["points"]) != nx * ny * nz:
+        fail("body has %d points, expected %d" % (len(body["points"]), nx * ny * nz))
+    if len(body["types"]) != ex * ey * ez or np.any(body["types"] != 12):
+        fail("body cells are not %d hexahedra" % (ex * ey * ez))
+    conn = body["connectivity"].reshape(-1, 8)
+    if conn.min() < 0 or conn.max() >= nx * ny * nz:
+        fail("connectivity out of range")
+    # Jacobian at each hexahedron's centre (VTK node order) has the brick's volume
+    q = body["points"][conn]  # cells x 8 x 3
+    j0 = (q[:, 1] - q[:, 0] + q[:, 2] - q[:, 3] + q[:, 5] - q[:, 4] + q[:, 6] - q[:, 7]) / 4
+    j1 = (q[:, 3] - q[:, 0] + q[:, 2] - q[:, 1] + q[:, 7] - q[:, 4] + q[:, 6] - q[:, 5]) / 4
+    j2 = (q[:, 4] - q[:, 0] + q[:, 5] - q[:, 1] + q[:, 6] - q[:, 2] + q[:, 7] - q[:, 3]) / 4
+    det = np.einsum("ij,ij->i", j0, np.cross(j1, j2))
+    if not np.allclose(det, det[0], rtol=1e-9) or det[0] <= 0:
+        fail("hexahedra of different or non-positive volume: %g..%g" % (det.min(), det.max()))
+    m = nx * ny
+    if len(face["points"]) != m or len(face["types"]) != ex * ey or np.any(face["types"] != 9):
+        fail("contact face is not %d points and %d quads" % (m, ex * ey))
+    if not np.array_equal(body["displacement"][:m], face["displacement"]):
+        fail("the body's bottom plane and the contact file disagree")
+    rows = list(csv.DictReader(open(args.csv)))
+    if len(rows) != run["contact_nodes"]:
+        fail("CSV has %d rows, JSON %d contact nodes" % (len(rows), run["contact_nodes"]))
+    n = np.array([int(r["ix"]) + nx * int(r["iy"]) for r in rows])
+    u = np.array([[float(r["ux"]), float(r["uy"]), float(r["uz"])] for r in rows])
+    lam = np.array([float(r["lambda"]) for r in rows])
+    code = np.array([1 if r["contact"] == "0" else (2 if r["stick"] == "1" else 3) for r in rows])
+    scale = np.abs(u).max()
+    if np.abs(face["displacement"][n] - u).max() > 1e-15 * scale:
+        fail("contact displacement differs from the CSV by %g" % np.abs(face["displacement"][n] - u).max())
+    if np.abs(face["lambda"][n] - lam).max() > 1e-15 * max(np.abs(lam).max(), 1):
+        fail("lambda differs from the CSV")
+    if not np.array_equal(face["contact_status"][n], code) or not np.array_equal(body["contact_status"][n], code):
+        fail("contact_status differs from the CSV")
+    if not np.array_equal(body["contact_force"][n][:, 2], face["lambda"][n]):
+        fail("the body's contact_force z differs from lambda")
+    summary = "%s: %d points, %d cells, %d contact nodes agree with the CSV" % (
+        args.vtu, len(body["points"]), len(body["types"]), len(rows))
+    if args.ascii:
+        for b, a in ((body, arrays(read(args.ascii))), (face, arrays(read(companion(args.ascii))))):
+            for k in b:
+                x, y = b[k].astype(float), a[k].astype(float)
+                if x.shape != y.shape or np.abs(x - y).max() > 1e-11 * max(np.abs(x).max(), 1e-300):
+                    fail("binary and ASCII differ in " + k)
+        sb = os.path.getsize(args.vtu) + os.path.getsize(companion(args.vtu))
+        sa = os.path.getsize(args.ascii) + os.path.getsize(companion(args.ascii))
+        summary += "; ASCII %d bytes, binary %d bytes: %.1fx smaller" % (sa, sb, sa / sb)
+        if sa < args.min_ratio * sb:
+            fail("binary is only %.2fx smaller than ASCII (need %g)" % (sa / sb, args.min_ratio))
+    print(summary)
+
+
+def check_pvd(args):
+    # VTK's Python module has no .pvd reader (that one is ParaView's): the
+    # collection is parsed here, and each file it names is read with VTK
+    import xml.etree.ElementTree as ET
+    sets = ET.parse(args.pvd).getroot().find("Collection").findall("DataSet")
+    steps = sorted({float(d.get("timestep")) for d in sets})
+    if args.json:  # the iterates of one Newton solve: x0 and one per step
+        with open(args.json) as f:
+            args.steps = json.load(f)["newton_iterations"] + 1
+    if len(steps) != args.steps:
+        fail("%s has %d steps, expected %d" % (args.pvd, len(steps), args.steps))
+    for t in steps:
+        parts = sorted(int(d.get("part")) for d in sets if float(d.get("timestep")) == t)
+        if parts != [0, 1]:
+            fail("step %g has parts %s, expected the body (0) and its contact face (1)" % (t, parts))
+    for d in sets:
+        read(os.path.join(os.path.dirname(args.pvd), d.get("file")))
+    print("%s: %d steps of 2 parts each, all read by VTK" % (args.pvd, len(steps)))
+
+
+p = argparse.ArgumentParser()
+p.add_argument("--vtu")
+p.add_argument("--csv")
+p.add_argument("--json")
+p.add_argument("--ascii")
+p.add_argument("--min-ratio", type=float, default=5)
+p.add_argument("--pvd")
+p.add_argument("--steps", type=int)
+a = p.parse_args()
+if a.pvd:
+    check_pvd(a)
+else:
+    check_run(a)
