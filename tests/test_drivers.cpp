@@ -282,6 +282,45 @@ TEST(TrescaDriver, OutputsNeverDestroyWhatTheyDoNotOwn) {
   expect_error("tresca --dims 4x2x2 --contact-csv " + dir + "/sub/", "not a file name");
 }
 
+// --initial: a restart from a run's own converged output converges at
+// iteration 0 (eps above the inner solves' noise: 1e-4 N of |b| = 2e7 N),
+// a continuation in phi starts from it; bad files are refused
+TEST(TrescaDriver, RestartsFromItsOwnContactCsv) {
+  const std::string dir = ::testing::TempDir(), csv = dir + "restart.csv", json = dir + "restart.json";
+  expect_run("tresca --level 7 --eps 1e-4 --quiet --contact-csv " + csv + " --json " + json, 0, "");
+  const std::string first = slurp(json);
+  EXPECT_NE(first.find("\"true_residual_within_eps\": true"), std::string::npos) << first;
+  expect_run("tresca --level 7 --eps 1e-4 --quiet --initial " + csv + " --json " + json, 0,
+             "converged after 0 Newton iterations");
+  const std::string again = slurp(json);
+  EXPECT_NE(again.find("\"newton_iterations\": 0"), std::string::npos) << again;
+  EXPECT_NE(again.find("\"nested\": []"), std::string::npos) << "a restart does not nest";
+  // continuation in phi: fewer steps than the cold start of the same case
+  const CmdResult cold = run("tresca --level 7 --phi 2 --eps 1e-4 --no-nested");
+  const CmdResult warm = run("tresca --level 7 --phi 2 --eps 1e-4 --initial " + csv);
+  ASSERT_EQ(cold.status, 0) << cold.out;
+  ASSERT_EQ(warm.status, 0) << warm.out;
+  auto steps = [](const std::string& out) {
+    const size_t at = out.find("converged after ");
+    return at == std::string::npos ? -1 : std::atoi(out.c_str() + at + 16);
+  };
+  EXPECT_LT(steps(warm.out), steps(cold.out)) << warm.out << cold.out;
+  // the wrong mesh, a missing column, a broken value: one line naming it
+  expect_error("tresca --level 6 --initial " + csv, "is not a contact node of this mesh");
+  {
+    std::ofstream f(dir + "restart_bad.csv");
+    f << "ix,iy,ux,uy,uz\n1,0,0,0,0\n";
+  }
+  expect_error("tresca --level 7 --initial " + dir + "restart_bad.csv", "no column 'lambda'");
+  {
+    std::ofstream f(dir + "restart_bad.csv");
+    f << "ix,iy,ux,uy,uz,lambda\n1,0,0,0,inf,0\n";
+  }
+  expect_error("tresca --level 7 --initial " + dir + "restart_bad.csv", "line 2: uz 'inf' is not a finite number");
+  expect_error("tresca --level 7 --initial /nonexistent.csv", "cannot read initial iterate '/nonexistent.csv'");
+  expect_error("tresca --table 1-2 --initial " + csv, "--initial");
+}
+
 TEST(TrescaDriver, TablePrintsPaperColumnsAndConverges) {
   const CmdResult r = run("tresca --table 2-3");
   EXPECT_EQ(r.status, 0) << r.out;

@@ -152,10 +152,23 @@ TEST(GapFile, ReadsEveryContactNodeAndRejectsTheRest) {
   };
   EXPECT_NE(error("x,y,gap\n").find("header"), std::string::npos);
   EXPECT_NE(error("ix,iy,gap\n0,0,0.1\n").find("line 2: node (0, 0) is not a contact node"), std::string::npos);
-  EXPECT_NE(error("ix,iy,gap\n1,0,-0.1\n").find("must be >= 0"), std::string::npos);
+  std::string negative = good;
+  negative.replace(negative.find("2,1,"), 8, "2,1,-0.1");
+  EXPECT_NE(error(negative).find("the gap at node (2, 1) is negative"), std::string::npos) << error(negative);
   EXPECT_NE(error("ix,iy,gap\n1,0,0.1\n1,0,0.2\n").find("line 3: node (1, 0) is given twice"), std::string::npos);
   EXPECT_NE(error("ix,iy,gap\n1,0,0.1\n").find("gives 1 of the 9 contact nodes"), std::string::npos);
-  EXPECT_NE(error("ix,iy,gap\n1;0;0.1\n").find("is not ix,iy,gap"), std::string::npos);
+  EXPECT_NE(error("ix,iy,gap\n1;0;0.1\n").find("line 2: has 1 fields, the header 3"), std::string::npos);
+  EXPECT_NE(error("ix,iy,gap\n1,0,abc\n").find("line 2: gap 'abc' is not a finite number"), std::string::npos);
+  EXPECT_NE(error("ix,iy,gap\n1,0,nan\n").find("not a finite number"), std::string::npos);
+  EXPECT_NE(error("ix,iy,gap\n1.5,0,0.1\n").find("node (1.5, 0) is not a contact node"), std::string::npos);
+  EXPECT_NE(error("").find("empty"), std::string::npos);
+  // columns by name, in any order, others ignored (the driver's own CSV qualifies)
+  std::string shuffled = "gap,note,iy,ix\n";
+  for (int iy = 0; iy <= 2; ++iy)
+    for (int ix = 1; ix <= 3; ++ix)
+      shuffled += std::to_string(0.01 * ix + 0.1 * iy) + ",x," + std::to_string(iy) + "," + std::to_string(ix) + "\n";
+  write(shuffled);
+  EXPECT_EQ(read_gap_csv(path, P.grid), g);
 }
 
 }  // namespace tresca

@@ -94,9 +94,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.newton.status.assign(p, 0);
   } else if (opt.coulomb >= 0 && opt.coulomb_method == RunOptions::CoulombMethod::lagged) {
     R.coulomb = true;
-    NewtonOptions lagged = newton;
-    lagged.coulomb = opt.coulomb;
-    R.newton = semismooth_newton(S, btilde, R.contact, lagged);
+    newton.coulomb = opt.coulomb;
+    R.newton = semismooth_newton(S, btilde, R.contact, newton);
     R.contact.phi = R.newton.phi;
     R.coulomb_loop.iterations = 1;
     R.coulomb_loop.reason = R.newton.converged() ? CoulombReason::converged : CoulombReason::tresca_failed;

@@ -1,6 +1,9 @@
 #include "core/io/problem_file.hpp"
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -180,38 +183,73 @@ ProblemFile read_problem_file(const std::string& path) {
   return parse_problem(os.str(), "problem file '" + path + "'");
 }
 
-std::vector<real> read_gap_csv(const std::string& path, const GridDims& g) {
+std::vector<std::vector<real>> read_contact_csv(const std::string& path, const GridDims& g,
+                                                const std::vector<std::string>& columns, const std::string& what) {
   std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot read gap file '" + path + "'");
-  auto fail = [&](long line, const std::string& what) {
-    throw std::invalid_argument("gap file '" + path + "' line " + std::to_string(line) + ": " + what);
+  if (!in) throw std::invalid_argument("cannot read " + what + " '" + path + "'");
+  auto fail = [&](long line, const std::string& why) {
+    throw std::invalid_argument(what + " '" + path + "' line " + std::to_string(line) + ": " + why);
+  };
+  auto fields = [](std::string row) {
+    if (!row.empty() && row.back() == '\r') row.pop_back();
+    std::vector<std::string> f;
+    std::istringstream is(row);
+    for (std::string x; std::getline(is, x, ',');) f.push_back(x);
+    if (!row.empty() && row.back() == ',') f.push_back("");
+    return f;
   };
   std::string row;
-  long line = 1;
-  if (!std::getline(in, row) || row.substr(0, 9) != "ix,iy,gap") fail(1, "the header must be 'ix,iy,gap'");
-  const index p = g.ex * g.ny();
-  std::vector<real> gap(p, -1);
-  index seen = 0;
-  while (std::getline(in, row)) {
-    ++line;
-    if (row.empty() || row == "\r") continue;
-    std::istringstream is(row);
-    long long ix, iy;
-    double v;
-    char c1, c2;
-    if (!(is >> ix >> c1 >> iy >> c2 >> v) || c1 != ',' || c2 != ',') fail(line, "'" + row + "' is not ix,iy,gap");
-    if (ix < 1 || ix > g.ex || iy < 0 || iy > g.ey)
-      fail(line, "node (" + std::to_string(ix) + ", " + std::to_string(iy) + ") is not a contact node (1 <= ix <= " +
-                     std::to_string(g.ex) + ", 0 <= iy <= " + std::to_string(g.ey) + ")");
-    if (!(v >= 0) || !std::isfinite(v)) fail(line, "gap " + std::to_string(v) + " must be >= 0 and finite");
-    const index c = (ix - 1) + g.ex * iy;
-    if (gap[c] >= 0) fail(line, "node (" + std::to_string(ix) + ", " + std::to_string(iy) + ") is given twice");
-    gap[c] = v;
-    ++seen;
+  std::vector<std::string> want{"ix", "iy"};
+  want.insert(want.end(), columns.begin(), columns.end());
+  std::string header_names;
+  for (const auto& w : want) header_names += (header_names.empty() ? "" : ",") + w;
+  if (!std::getline(in, row)) fail(1, "empty; the header must name " + header_names);
+  const std::vector<std::string> head = fields(row);
+  std::vector<size_t> col(want.size());
+  for (size_t k = 0; k < want.size(); ++k) {
+    const auto it = std::find(head.begin(), head.end(), want[k]);
+    if (it == head.end()) fail(1, "the header has no column '" + want[k] + "' (it must name " + header_names + ")");
+    col[k] = size_t(it - head.begin());
   }
-  if (seen != p)
-    throw std::invalid_argument("gap file '" + path + "' gives " + std::to_string(seen) + " of the " +
-                                std::to_string(p) + " contact nodes");
+  const index p = g.ex * g.ny();
+  std::vector<std::vector<real>> out(columns.size(), std::vector<real>(p));
+  std::vector<char> seen(p, 0);
+  index count = 0;
+  for (long line = 2; std::getline(in, row); ++line) {
+    if (row.empty() || row == "\r") continue;
+    const std::vector<std::string> f = fields(row);
+    if (f.size() != head.size())
+      fail(line, "has " + std::to_string(f.size()) + " fields, the header " + std::to_string(head.size()));
+    std::vector<double> v(want.size());
+    for (size_t k = 0; k < want.size(); ++k) {
+      const std::string& x = f[col[k]];
+      char* end = nullptr;
+      errno = 0;
+      v[k] = std::strtod(x.c_str(), &end);
+      if (x.empty() || *end != '\0' || !std::isfinite(v[k]) || (errno == ERANGE && std::abs(v[k]) > 1))
+        fail(line, want[k] + " '" + x.substr(0, 40) + "' is not a finite number");
+    }
+    if (v[0] != std::floor(v[0]) || v[1] != std::floor(v[1]) || v[0] < 1 || v[0] > g.ex || v[1] < 0 || v[1] > g.ey)
+      fail(line, "node (" + f[col[0]] + ", " + f[col[1]] + ") is not a contact node of this mesh (1 <= ix <= " +
+                     std::to_string(g.ex) + ", 0 <= iy <= " + std::to_string(g.ey) + ")");
+    const index c = (index(v[0]) - 1) + g.ex * index(v[1]);
+    if (seen[c]) fail(line, "node (" + f[col[0]] + ", " + f[col[1]] + ") is given twice");
+    seen[c] = 1;
+    ++count;
+    for (size_t k = 0; k < columns.size(); ++k) out[k][c] = v[k + 2];
+  }
+  if (count != p)
+    throw std::invalid_argument(what + " '" + path + "' gives " + std::to_string(count) + " of the " +
+                                std::to_string(p) + " contact nodes of this mesh");
+  return out;
+}
+
+std::vector<real> read_gap_csv(const std::string& path, const GridDims& g) {
+  std::vector<real> gap = std::move(read_contact_csv(path, g, {"gap"}, "gap file")[0]);
+  for (index c = 0; c < index(gap.size()); ++c)
+    if (gap[c] < 0)
+      throw std::invalid_argument("gap file '" + path + "': the gap at node (" + std::to_string(1 + c % g.ex) + ", " +
+                                  std::to_string(c / g.ex) + ") is negative");
   return gap;
 }
 

@@ -36,9 +36,15 @@ struct ProblemFile {
 // throws std::invalid_argument with a one-line message
 ProblemFile read_problem_file(const std::string& path);
 ProblemFile parse_problem(const std::string& text, const std::string& origin = "problem");
-// Gaps per contact node from a CSV file with the header `ix,iy,gap` and one
-// row per contact node (1 <= ix <= ex, 0 <= iy <= ey; gap >= 0 in metres),
-// every contact node exactly once; throws with the file, line and value.
+// Values per contact node from a CSV file whose header names ix, iy and
+// `columns` (in any order; other columns are ignored, so the driver's own
+// --contact-csv output qualifies): one row per contact node (1 <= ix <= ex,
+// 0 <= iy <= ey), every contact node exactly once, finite numbers. Returns
+// one vector per column, in contact-node order; throws std::invalid_argument
+// naming `what`, the file, the line and the value.
+std::vector<std::vector<real>> read_contact_csv(const std::string& path, const GridDims& g,
+                                                const std::vector<std::string>& columns, const std::string& what);
+// the gap per contact node (>= 0, metres) from the column `gap`
 std::vector<real> read_gap_csv(const std::string& path, const GridDims& g);
 // the problem in the file's schema, as JSON text (one line)
 std::string problem_json(const ProblemSpec& s, real coulomb);

@@ -76,6 +76,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
       .array("inner_iterations_history", std::vector<double>(N.inner_history.begin(), N.inner_history.end()))
       .array("outer_iterations_history", std::vector<double>(N.outer_history.begin(), N.outer_history.end())).num("final_residual", N.history.empty() ? NAN : N.history.back())
       .num("true_residual", F.true_residual).num("true_residual_relative", F.true_residual_relative)
+      .boolean("true_residual_within_eps", F.true_residual <= eps)
       .raw("times", times.render()).raw("counts", counts.render()).raw("contact", contact.render())
       .raw("kkt", kkt.render()).raw("problem", problem_json(spec, R.coulomb ? opt.coulomb : -1)).raw("nested", nested).raw("coulomb", R.coulomb ? coulomb.render() : "null").num("peak_memory_bytes", R.peak_memory);
   return j;
