@@ -245,7 +245,7 @@ int main(int argc, char** argv) {
       std::vector<PvdStep> steps;
       std::printf("%5s %9s %9s %9s %7s %9s %5s %5s | paper: %9s %9s %9s %5s | %s\n", "level", "n", "setup", "condense",
                   "p", "solve", "iters", "conv", "assembly", "schur", "solver", "iters", "true residual (rel)");
-      std::string rows = "[";
+      Json rows = Json::array();
       bool all = true;
       for (int L : levels) {
         ProblemSpec s = spec_for_level(L);
@@ -272,10 +272,10 @@ int main(int argc, char** argv) {
                     R.report.true_residual, R.report.true_residual_relative);
         std::fflush(stdout);
         all = all && R.converged();
-        rows += (rows.size() > 1 ? ",\n " : "") + run_summary(s, R, threads, opt).render();
+        rows.push_back(run_summary(s, R, threads, opt));
       }
       try {
-        if (!json_path.empty()) write_text(out, json_path, rows + "]\n");
+        if (!json_path.empty()) write_text(out, json_path, json_text(rows));
         if (!vtk_path.empty()) write_pvd(out, pvd_name(vtk_path), steps);
         out.publish();
       } catch (const std::exception& e) {
@@ -363,7 +363,7 @@ int main(int argc, char** argv) {
       const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.contact.phi, &R.contact.gap};
       // all of the run's outputs, or none of them (output.hpp: OutputSet)
       if (every_iteration) write_pvd(out, pvd_name(vtk_path), steps);
-      if (!json_path.empty()) write_text(out, json_path, run_summary(spec, R, threads, opt).render() + "\n");
+      if (!json_path.empty()) write_text(out, json_path, json_text(run_summary(spec, R, threads, opt)));
       if (!csv_path.empty()) write_contact_csv(out, csv_path, *R.problem, cf);
       std::string second;
       if (!vtk_path.empty()) second = write_vtu(out, vtk_path, *R.problem, R.u_full, cf, vtk_format);

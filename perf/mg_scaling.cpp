@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
     std::printf("# kernels: %s, %d threads\n", build_info().c_str(), threads);
     std::printf("%5s %11s %-70s %6s %9s %9s %11s %s\n", "level", "dofs", "hierarchy", "iters", "setup[s]", "solve[s]",
                 "s/iter", "rel.res (recomputed)");
-    std::string rows = "[";
+    Json rows = Json::array();
     bool all_ok = true;
     for (int L : levels) {
       const Problem P = make_problem(spec_for_level(L));
@@ -50,14 +50,19 @@ int main(int argc, char** argv) {
                   st.ok() ? "" : to_string(st.reason));
       std::fflush(stdout);
       all_ok = all_ok && st.ok();
-      Json j;
-      j.integer("level", L).integer("dofs", P.dofs()).integer("levels", mg.num_levels())
-          .integer("iterations", st.iterations).num("setup", t1 - t0).num("solve", solve)
-          .num("relative_residual", rel).str("reason", to_string(st.reason)).integer("threads", threads).str("build", build_info())
-          .str("precision", to_string(mo.precision));
-      rows += (rows.size() > 1 ? ",\n " : "") + j.render();
+      rows.push_back({{"level", L},
+                      {"dofs", P.dofs()},
+                      {"levels", mg.num_levels()},
+                      {"iterations", st.iterations},
+                      {"setup", t1 - t0},
+                      {"solve", solve},
+                      {"relative_residual", rel},
+                      {"reason", to_string(st.reason)},
+                      {"threads", threads},
+                      {"build", build_info()},
+                      {"precision", to_string(mo.precision)}});
     }
-    if (!json.empty()) write_file_atomic(json, rows + "]\n");
+    if (!json.empty()) write_file_atomic(json, json_text(rows));
     if (!all_ok) std::fprintf(stderr, "mg_scaling: some solves did not converge (see the last column)\n");
     return all_ok ? 0 : 1;
   } catch (const std::exception& e) {

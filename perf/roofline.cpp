@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
     std::printf("# level %lld: mesh %s, %lld dofs\n", level, dims_string(spec).c_str(), (long long)n);
     std::printf("%-20s %10s %11s %8s %8s %9s %8s %9s\n", "kernel", "time [ms]", "M items/s", "GB/s", "of BW",
                 "GFLOP/s", "of peak", "of bound");
-    std::string kernels;
+    Json kernels = Json::array();
     for (size_t i = 0; i < rows.size(); ++i) {
       const Row& r = rows[i];
       const double gbs = r.cost.bytes / r.seconds, gfs = r.cost.flops / r.seconds;
@@ -191,17 +191,24 @@ int main(int argc, char** argv) {
       else
         std::printf("%-20s %10.3f %11.1f %8s %8s %9s %8s %9s\n", r.name.c_str(), r.seconds * 1e3,
                     r.items / r.seconds * 1e-6, "-", "-", "-", "-", "-");
-      Json j;
-      j.str("kernel", r.name).num("seconds", r.seconds).num("items_per_s", r.items / r.seconds)
-          .num("bytes_per_s", gbs).num("flops_per_s", gfs).num("fraction_of_bandwidth", gbs / bw)
-          .num("fraction_of_peak", gfs / pk).num("fraction_of_bound", bound / r.seconds);
-      kernels += (i ? ",\n  " : "\n  ") + j.render();
+      kernels.push_back({{"kernel", r.name},
+                         {"seconds", r.seconds},
+                         {"items_per_s", r.items / r.seconds},
+                         {"bytes_per_s", gbs},
+                         {"flops_per_s", gfs},
+                         {"fraction_of_bandwidth", gbs / bw},
+                         {"fraction_of_peak", gfs / pk},
+                         {"fraction_of_bound", bound / r.seconds}});
     }
-    Json out;
-    out.str("build", build_info()).integer("threads", threads).integer("level", level)
-        .num("triad_stream_bytes_per_s", stream).num("bandwidth_bytes_per_s", bw).num("peak_flops_per_s", peak)
-        .num("peak_flops_per_s_single", peak_single).raw("kernels", "[" + kernels + "]");
-    if (!json.empty()) write_file_atomic(json, out.render() + "\n");
+    const Json out = {{"build", build_info()},
+                      {"threads", threads},
+                      {"level", level},
+                      {"triad_stream_bytes_per_s", stream},
+                      {"bandwidth_bytes_per_s", bw},
+                      {"peak_flops_per_s", peak},
+                      {"peak_flops_per_s_single", peak_single},
+                      {"kernels", kernels}};
+    if (!json.empty()) write_file_atomic(json, json_text(out));
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "roofline: error: %s\n", e.what());

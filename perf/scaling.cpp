@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
                 "dofs", "nested", "setup", "condense", "solve", "recover", "total", "fp", "newton", "outer", "inner", "S-app",
                 "fmv/step", "fmv nest", "fmv/solve", "fmv K_ii", "ratio", "peak GB", "speedup");
     bool all_converged = true;
-    std::string rows = "[";
+    Json rows = Json::array();
     for (int L : levels) {
       ProblemSpec s = spec_for_level(L);
       s.phi = phi;
@@ -98,12 +98,13 @@ int main(int argc, char** argv) {
         all_converged = all_converged && R.converged();
         std::fflush(stdout);
         Json j = run_summary(s, R, T, o);
-        j.num("speedup", speedup).num("fine_matvecs_linear_solve", fmv_linear)
-            .num("contact_over_linear", R.fine_matvecs_total / fmv_linear);
-        rows += (rows.size() > 1 ? ",\n " : "") + j.render();
+        j["speedup"] = speedup;
+        j["fine_matvecs_linear_solve"] = fmv_linear;
+        j["contact_over_linear"] = R.fine_matvecs_total / fmv_linear;
+        rows.push_back(std::move(j));
       }
     }
-    if (!json.empty()) write_file_atomic(json, rows + "]\n");
+    if (!json.empty()) write_file_atomic(json, json_text(rows));
     if (!all_converged) std::fprintf(stderr, "scaling: some solves did not converge (see the last column)\n");
     return all_converged ? 0 : 1;
   } catch (const std::exception& e) {

@@ -237,53 +237,7 @@ void write_file_atomic(const std::string& path, const std::string& contents) {
   out.publish();
 }
 
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
-
-Json& Json::num(const std::string& k, double v) {
-  items_.push_back({k, json_number(v)});
-  return *this;
-}
-Json& Json::integer(const std::string& k, long long v) {
-  items_.push_back({k, std::to_string(v)});
-  return *this;
-}
-Json& Json::boolean(const std::string& k, bool v) {
-  items_.push_back({k, v ? "true" : "false"});
-  return *this;
-}
-Json& Json::str(const std::string& k, const std::string& v) {
-  std::string e = "\"";
-  for (char c : v) {
-    if (c == '"' || c == '\\') e += '\\';
-    e += c;
-  }
-  items_.push_back({k, e + "\""});
-  return *this;
-}
-Json& Json::null(const std::string& k) {
-  items_.push_back({k, "null"});
-  return *this;
-}
-Json& Json::array(const std::string& k, const std::vector<double>& v) {
-  std::string s = "[";
-  for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + json_number(v[i]);
-  items_.push_back({k, s + "]"});
-  return *this;
-}
-Json& Json::raw(const std::string& k, const std::string& json) {
-  items_.push_back({k, json});
-  return *this;
-}
-std::string Json::render() const {
-  std::string s = "{";
-  for (size_t i = 0; i < items_.size(); ++i) s += (i ? ", " : "") + ("\"" + items_[i].first + "\": ") + items_[i].second;
-  return s + "}";
-}
+std::string json_text(const Json& j) { return j.dump(1) + "\n"; }
 
 void write_contact_csv(OutputSet& out, const std::string& path, const Problem& P, const ContactFields& c) {
   OutputHandle f{out.create(path)};

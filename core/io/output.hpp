@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/fem/problem.hpp"
 
 namespace tresca {
@@ -50,22 +52,11 @@ void write_text(OutputSet& out, const std::string& path, const std::string& cont
 // one file on its own: write_text + publish
 void write_file_atomic(const std::string& path, const std::string& contents);
 
-// Tiny JSON object builder (keys in insertion order).
-class Json {
- public:
-  Json& num(const std::string& k, double v);
-  Json& integer(const std::string& k, long long v);
-  Json& boolean(const std::string& k, bool v);
-  Json& str(const std::string& k, const std::string& v);
-  Json& null(const std::string& k);
-  Json& array(const std::string& k, const std::vector<double>& v);
-  Json& raw(const std::string& k, const std::string& json);  // pre-rendered value
-  std::string render() const;
-
- private:
-  std::vector<std::pair<std::string, std::string>> items_;
-};
-std::string json_number(double v);
+// JSON documents (run summaries, perf records): nlohmann's, keys in
+// insertion order; non-finite numbers are written as null. `json_text`
+// renders one as a file's contents (indented, newline-terminated).
+using Json = nlohmann::ordered_json;
+std::string json_text(const Json& j);
 
 struct ContactFields {
   const std::vector<real>* u;       // 3p
