@@ -214,6 +214,12 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  if (opt.newton.scaling == StepScaling::paper && (spec.E < 1e6 || spec.E > 1e12))
+    std::fprintf(stderr,
+                 "tresca: warning: --scaling paper adds forces [N] and displacements [m] as numbers, which suits the\n"
+                 "  paper's E = 2.1e9 Pa; at E = %g Pa they differ by many orders and Newton may stagnate\n"
+                 "  (--scaling diagonal, the default outside --table, does not depend on the units)\n",
+                 spec.E);
   if (spec.nu > 0.49)
     std::fprintf(stderr,
                  "tresca: warning: nu = %g is nearly incompressible: Q1 elements lock and the multigrid inner solver "
@@ -337,6 +343,11 @@ int main(int argc, char** argv) {
                 opt.newton.eps);
     std::printf("true residual (fresh S u): %.3e absolute, %.3e relative to |b| = %.3e\n", F.true_residual,
                 F.true_residual_relative, F.btilde_norm);
+    if (N.reason == NewtonReason::stagnation && !N.history.empty() && N.history.back() <= 1e-9 * N.history.front())
+      std::printf("note: |v| stagnated at %.1e of its initial value, the accuracy the inner solves attain: eps = %.1e\n"
+                  "      is out of reach for this problem's magnitudes (--eps %.0e would be met)\n",
+                  N.history.back() / N.history.front(), opt.newton.eps,
+                  std::pow(10.0, std::ceil(std::log10(2 * N.history.back()))));
     if (N.converged() && !(F.true_residual <= opt.newton.eps))
       std::printf("note: the true residual exceeds eps = %.1e, which is %.1e of |b|: below what the inner solves\n"
                   "      resolve (about 1e-12 relative), so the tracked |v| and a fresh one differ by more than eps;\n"

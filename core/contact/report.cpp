@@ -9,7 +9,8 @@
 namespace tresca {
 
 FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
-                         const NewtonResult& R, real tight_rtol, std::vector<real>* extension, bool warm) {
+                         const NewtonResult& R, real tight_rtol, std::vector<real>* extension, bool warm,
+                         StepScaling scaling) {
   const index p = S.size() / 3;
   const std::vector<real>& phi = law.phi;
   FinalReport F;
@@ -20,7 +21,11 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
   F.r.resize(3 * p);
   for (index i = 0; i < 3 * p; ++i) F.r[i] = Su[i] - btilde[i];
   F.status.resize(p);
-  F.true_residual = std::sqrt(approximation_step(p, law.law(), nullptr, R.u.data(), R.lambda.data(), F.r.data(), v.data(),
+  // the residual is the paper's |v̂| either way; the status (which nodes are
+  // in contact, which stick) is decided in Newton's metric, so that it does
+  // not depend on the units where a node is on the edge of two states
+  const std::vector<real> scale = scaling == StepScaling::diagonal ? step_scale(S) : std::vector<real>{};
+  F.true_residual = std::sqrt(approximation_step(p, law.law(), scale.empty() ? nullptr : scale.data(), R.u.data(), R.lambda.data(), F.r.data(), v.data(),
                                                  d.data(), F.status.data()));
   F.btilde_norm = norm2(3 * p, btilde.data());
   F.true_residual_relative = F.btilde_norm > 0 ? F.true_residual / F.btilde_norm : F.true_residual;
