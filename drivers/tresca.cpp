@@ -308,13 +308,19 @@ int main(int argc, char** argv) {
     // --vtk-every-iteration: the iterates' files, published with the run's others
     OutputSet out;
     std::vector<PvdStep> steps;
+    std::string iterate_error;  // a failed write of an iterate: reported (exit 3) after the solve
     if (every_iteration)
       opt.iterate_done = [&](const Iterate& it) {
-        const NewtonProgress& pr = *it.progress;
-        const ContactFields cf{pr.u, pr.lambda, pr.r, pr.status, pr.phi, it.gap};
-        const std::string v = vtu_step_name(vtk_path, "_it" + std::to_string(it.step));
-        steps.push_back({double(it.step), {v, write_vtu(out, v, *it.problem, *it.u_full, cf, vtk_format)}});
-        out.finish();
+        if (!iterate_error.empty()) return;
+        try {
+          const NewtonProgress& pr = *it.progress;
+          const ContactFields cf{pr.u, pr.lambda, pr.r, pr.status, pr.phi, it.gap};
+          const std::string v = vtu_step_name(vtk_path, "_it" + std::to_string(it.step));
+          steps.push_back({double(it.step), {v, write_vtu(out, v, *it.problem, *it.u_full, cf, vtk_format)}});
+          out.finish();
+        } catch (const std::exception& e) {
+          iterate_error = e.what();
+        }
       };
     const RunResult R = run_tresca(spec, opt);
     const NewtonResult& N = R.newton;
@@ -373,6 +379,7 @@ int main(int argc, char** argv) {
     try {
       const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.contact.phi, &R.contact.gap};
       // all of the run's outputs, or none of them (output.hpp: OutputSet)
+      if (!iterate_error.empty()) throw std::runtime_error(iterate_error);
       if (every_iteration) write_pvd(out, pvd_name(vtk_path), steps);
       if (!json_path.empty()) write_text(out, json_path, json_text(run_summary(spec, R, threads, opt)));
       if (!csv_path.empty()) write_contact_csv(out, csv_path, *R.problem, cf);
