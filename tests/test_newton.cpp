@@ -236,6 +236,16 @@ void compare_with_dense(const NewtonOptions& method, index ex, index ey, index e
   EXPECT_LT(F.true_residual_relative, 1e-10);
 }
 
+// a whole run on the 12x6x6 mesh (nested, default options), contact values only
+RunResult solve_12x6x6(real phi, real E = ProblemSpec{}.E) {
+  ProblemSpec spec = spec_for_dims(12, 6, 6);
+  spec.phi = phi;
+  spec.E = E;
+  RunOptions o;
+  o.recover_interior = false;
+  return run_tresca(spec, o);
+}
+
 }  // namespace
 
 real uniform(real phi, index) { return phi; }
@@ -284,16 +294,13 @@ TEST(SemismoothNewton, MatchesDenseReferenceWhereThePaperStepLosesThePath) {
 TEST(SemismoothNewton, ConvergesSuperlinearly) {
   // the ratios |v̂_k+1|/|v̂_k| fall step by step to the end (measured: 0.61,
   // 0.032, 1.4e-4, 1.7e-7); every |v̂| here is above the floor 0.1 eps
-  ProblemSpec spec = spec_for_dims(12, 6, 6);
-  spec.phi = 1e6;
-  RunOptions o;
-  o.recover_interior = false;
-  const RunResult R = run_tresca(spec, o);
+  const RunResult R = solve_12x6x6(1e6);
   ASSERT_TRUE(R.newton.converged());
+  const real eps = NewtonOptions{}.eps;
   const std::vector<real>& h = R.newton.history;
   ASSERT_GE(h.size(), 5u);
   std::vector<real> q;
-  for (size_t k = 0; k + 1 < h.size() && h[k + 1] > 10 * o.newton.eps; ++k) q.push_back(h[k + 1] / h[k]);
+  for (size_t k = 0; k + 1 < h.size() && h[k + 1] > 10 * eps; ++k) q.push_back(h[k + 1] / h[k]);
   ASSERT_GE(q.size(), 3u);
   for (size_t k = 1; k < q.size(); ++k) EXPECT_LT(q[k], 0.1 * q[k - 1]) << "ratio " << k;
   EXPECT_LT(q.back(), 1e-5);
@@ -373,23 +380,18 @@ TEST(SemismoothNewton, ResultsAgreeWithOneAndTwoThreads) {
 // the same steps, contact and stick sets, E u and lambda, where nodes stick,
 // slide and separate.
 TEST(SemismoothNewton, TheDiagonalMetricMakesTheSolveIndependentOfYoungsModulus) {
-  ProblemSpec spec = spec_for_dims(12, 6, 6);
-  spec.phi = 3e6;
-  RunOptions o;
-  o.recover_interior = false;
-  const RunResult ref = run_tresca(spec, o);
+  const RunResult ref = solve_12x6x6(3e6);
+  const real E0 = ProblemSpec{}.E;
   ASSERT_TRUE(ref.converged()) << ref.reason();
   for (real E : {1e13, 1e16}) {
-    ProblemSpec s = spec;
-    s.E = E;
-    const RunResult R = run_tresca(s, o);
+    const RunResult R = solve_12x6x6(3e6, E);
     ASSERT_TRUE(R.converged()) << "E = " << E << ": " << R.reason();
     EXPECT_EQ(R.newton.iterations, ref.newton.iterations) << "E = " << E;
     EXPECT_EQ(R.report.status, ref.report.status) << "E = " << E;
     const index p = R.problem->contact_nodes();
     const real umax = test::max_abs(ref.newton.u), lmax = test::max_abs(ref.newton.lambda);
     for (index i = 0; i < 3 * p; ++i)
-      ASSERT_NEAR(R.newton.u[i] * E / spec.E, ref.newton.u[i], 1e-7 * umax) << "E = " << E << ", entry " << i;
+      ASSERT_NEAR(R.newton.u[i] * E / E0, ref.newton.u[i], 1e-7 * umax) << "E = " << E << ", entry " << i;
     for (index i = 0; i < p; ++i) ASSERT_NEAR(R.newton.lambda[i], ref.newton.lambda[i], 1e-7 * lmax) << "E = " << E;
   }
 }
