@@ -355,9 +355,7 @@ int main(int argc, char** argv) {
                   N.history.back() / N.history.front(), opt.newton.eps,
                   std::pow(10.0, std::ceil(std::log10(2 * N.history.back()))));
     if (N.converged() && !(F.true_residual <= opt.newton.eps))
-      std::printf("note: the true residual exceeds eps = %.1e, which is %.1e of |b|: below what the inner solves\n"
-                  "      resolve (about 1e-12 relative), so the tracked |v| and a fresh one differ by more than eps;\n"
-                  "      a restart (--initial) from this output starts at the true residual\n",
+      std::printf("note: the true residual is above eps = %.1e = %.1e |b|, finer than the inner solves resolve (~1e-12 |b|)\n",
                   opt.newton.eps, opt.newton.eps / F.btilde_norm);
     std::printf("KKT: equilibrium %.2e N, uz<0 %.2e m, lambda<0 %.2e N, lambda*uz %.2e Nm, |r_t|-phi %.2e N, direction %.2e N, stick slip %.2e m\n",
                 F.equilibrium, F.uz_violation, F.lambda_violation, F.complementarity, F.friction_bound,
