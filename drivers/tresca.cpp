@@ -42,8 +42,9 @@ const char* kHelp =
     "                     continuation in phi or load, or a restart); no nested iteration\n"
     "  --coulomb F        Coulomb friction, bound phi_i = F lambda_i per contact node (F >= 0),\n"
     "                     excludes --phi\n"
-    "  --coulomb-method lagged|fixed-point  the bound follows lambda at every Newton step of\n"
-    "                     one solve (default), or a fixed point of whole Tresca solves\n"
+    "  --coulomb-method newton|lagged|fixed-point  one Newton solve whose step differentiates\n"
+    "                     phi = F lambda (default; boundary GMRES), one whose bound follows lambda\n"
+    "                     a step late (symmetric, CG), or a fixed point of whole Tresca solves\n"
     "  --gap G            the rigid plane lies G >= 0 metres below the contact face (default 0)\n"
     "  --eps E            stopping tolerance on ||v|| (default 1e-6, absolute)\n"
     "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
@@ -160,10 +161,8 @@ int main(int argc, char** argv) {
       throw std::invalid_argument("--mg-precision '" + prec + "' must be single or double");
     opt.mg.precision = prec == "single" ? Precision::single_precision : Precision::double_precision;
     if (a.has("--phi")) opt.coulomb = -1;  // the command line's Tresca bound over a file's Coulomb
-    const std::string method = a.str("--coulomb-method", "lagged");
-    if (method != "lagged" && method != "fixed-point")
-      throw std::invalid_argument("--coulomb-method '" + method + "' must be lagged or fixed-point");
-    opt.coulomb_method = method == "lagged" ? RunOptions::CoulombMethod::lagged : RunOptions::CoulombMethod::fixed_point;
+    const std::string method = a.str("--coulomb-method", to_string(RunOptions{}.coulomb_method));
+    opt.coulomb_method = coulomb_method_from(method, "--coulomb-method");
     if (a.has("--coulomb")) {
       opt.coulomb = a.real_value("--coulomb", 0);
       if (!(opt.coulomb >= 0) || !std::isfinite(opt.coulomb))
@@ -330,11 +329,13 @@ int main(int argc, char** argv) {
     if (R.coulomb) {
       const CoulombResult& C = R.coulomb_loop;
       if (R.coulomb_fallback)
-        std::printf("Coulomb F = %g: the lagged bound did not converge; the fixed point of Tresca solves took over\n",
+        std::printf("Coulomb F = %g: the Newton solve did not converge; the fixed point of Tresca solves took over\n",
                     opt.coulomb);
-      if (opt.coulomb_method == RunOptions::CoulombMethod::lagged && !R.coulomb_fallback) {
-        std::printf("Coulomb F = %g, the bound phi_i = F lambda_i updated at every Newton step; max |phi_i - F lambda_i| = %.2e N\n",
-                    opt.coulomb, R.coulomb_consistency);
+      if (opt.coulomb_method != RunOptions::CoulombMethod::fixed_point && !R.coulomb_fallback) {
+        std::printf("Coulomb F = %g, the bound phi_i = F lambda_i %s at every Newton step; max |phi_i - F lambda_i| = %.2e N\n",
+                    opt.coulomb,
+                    opt.coulomb_method == RunOptions::CoulombMethod::newton ? "differentiated" : "updated",
+                    R.coulomb_consistency);
       } else {
         std::printf("Coulomb F = %g: %s after %d Tresca solves, %lld Newton steps in all (reason: %s); changes of phi:",
                     opt.coulomb, C.converged() ? "converged" : "NOT CONVERGED", C.iterations, C.newton_steps,

@@ -28,9 +28,9 @@ using namespace tresca;
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
   try {
-    Args a(argc, argv, {"--levels", "--threads", "--phi", "--coulomb", "--json"}, {"--help", "--no-nested"});
+    Args a(argc, argv, {"--levels", "--threads", "--phi", "--coulomb", "--coulomb-method", "--json"}, {"--help", "--no-nested"});
     if (a.has("--help")) {
-      std::puts("usage: scaling [--levels 4-10] [--threads 1,2] [--phi F | --coulomb F] [--no-nested] [--json FILE]");
+      std::puts("usage: scaling [--levels 4-10] [--threads 1,2] [--phi F | --coulomb F [--coulomb-method M]] [--no-nested] [--json FILE]");
       return 0;
     }
     const auto levels = parse_level_range(a.str("--levels", "4-10"));
@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
     const double phi = a.real_value("--phi", 1.0);
     const bool nested = !a.has("--no-nested");
     const double coulomb = a.has("--coulomb") ? a.real_value("--coulomb", 0) : -1;
+    const RunOptions::CoulombMethod method = coulomb_method_from(a.str("--coulomb-method", to_string(RunOptions{}.coulomb_method)), "--coulomb-method");
     if (a.has("--coulomb") && !(coulomb >= 0)) throw std::invalid_argument("--coulomb " + a.str("--coulomb") + " must be >= 0");
     const std::string json = a.str("--json");
     if (!json.empty()) check_writable(json);
@@ -84,6 +85,7 @@ int main(int argc, char** argv) {
         o.recover_interior = true;
         o.nested = nested;
         o.coulomb = coulomb;
+        o.coulomb_method = method;
         const RunResult R = run_tresca(s, o);
         if (T == threads.front()) t_first = R.times.total;
         const double speedup = t_first / R.times.total;

@@ -95,7 +95,7 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --dims 4x2x2 --gap nan", "nan");
   expect_error("tresca --dims 4x2x2 --coulomb -0.1", "-0.1");
   expect_error("tresca --dims 4x2x2 --coulomb 0.3 --phi 5", "--phi");
-  expect_error("tresca --dims 4x2x2 --coulomb 0.3 --coulomb-method newton", "newton");
+  expect_error("tresca --dims 4x2x2 --coulomb 0.3 --coulomb-method secant", "--coulomb-method 'secant' must be newton, lagged or fixed-point");
   expect_error("tresca --dims 4x2x2 --obstacle cone:1,2,3", "cone");
   expect_error("tresca --dims 4x2x2 --obstacle sphere:1,2", "sphere:RADIUS,CX,CY,GAP");
   expect_error("tresca --dims 4x2x2 --obstacle sphere:-1,1,0.5,0", "radius");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/contact/nested.hpp"
 #include "kernels/transfer.hpp"
@@ -19,6 +20,22 @@ ContactConditions contact_conditions(const ProblemSpec& spec) {
     c.gap[i] = spec.obstacle.gap_at(x, y);
   }
   return c;
+}
+
+const char* to_string(RunOptions::CoulombMethod m) {
+  switch (m) {
+    case RunOptions::CoulombMethod::lagged: return "lagged";
+    case RunOptions::CoulombMethod::newton: return "newton";
+    case RunOptions::CoulombMethod::fixed_point: return "fixed_point";
+  }
+  return "?";
+}
+
+RunOptions::CoulombMethod coulomb_method_from(const std::string& s, const std::string& option) {
+  if (s == "lagged") return RunOptions::CoulombMethod::lagged;
+  if (s == "newton") return RunOptions::CoulombMethod::newton;
+  if (s == "fixed-point" || s == "fixed_point") return RunOptions::CoulombMethod::fixed_point;
+  throw std::invalid_argument(option + " '" + s + "' must be newton, lagged or fixed-point");
 }
 
 RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
@@ -92,9 +109,10 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.newton.u.assign(3 * p, 0);
     R.newton.lambda.assign(p, 0);
     R.newton.status.assign(p, 0);
-  } else if (opt.coulomb >= 0 && opt.coulomb_method == RunOptions::CoulombMethod::lagged) {
+  } else if (opt.coulomb >= 0 && opt.coulomb_method != RunOptions::CoulombMethod::fixed_point) {
     R.coulomb = true;
     newton.coulomb = opt.coulomb;
+    newton.coulomb_newton = opt.coulomb_method == RunOptions::CoulombMethod::newton;
     R.newton = semismooth_newton(S, btilde, R.contact, newton);
     R.contact.phi = R.newton.phi;
     R.coulomb_loop.iterations = 1;
@@ -146,11 +164,11 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   // the lagged Coulomb bound can oscillate for large F (measured: F = 1.5
   // on 32x16x16, stick and slip flipping every step); then the whole run
   // again with the fixed point of Tresca solves, its work and time added
-  if (R.coulomb && opt.coulomb_method == RunOptions::CoulombMethod::lagged && !R.newton.converged() &&
+  if (R.coulomb && opt.coulomb_method != RunOptions::CoulombMethod::fixed_point && !R.newton.converged() &&
       (R.newton.reason == NewtonReason::stagnation || R.newton.reason == NewtonReason::iteration_limit)) {
     RunOptions f = opt;
     f.coulomb_method = RunOptions::CoulombMethod::fixed_point;
-    if (opt.phase_done) opt.phase_done("Coulomb: the lagged bound did not converge; again by the fixed point", R.times.total);
+    if (opt.phase_done) opt.phase_done("Coulomb: one Newton solve did not converge; again by the fixed point", R.times.total);
     RunResult F = run_tresca(spec, f);
     F.coulomb_fallback = true;
     F.fine_matvecs_total += R.fine_matvecs_total;

@@ -61,12 +61,22 @@ struct RunOptions {
   // phi_i = F lambda_i (contact.phi / spec.phi are then not used); < 0: Tresca
   real coulomb = -1;
   real coulomb_tol = 1e-6;
-  // how: the bound lagged by one Newton step inside one solve (semismooth.hpp,
-  // NewtonOptions::coulomb; 2x the Tresca work at F = 0.3, 3.6-4x at F = 0.8,
-  // and if it fails, e.g. oscillates for large F, the fixed point takes over),
-  // or a fixed point of whole Tresca solves (coulomb.hpp; 2.8x and 5.6-6.3x)
-  enum class CoulombMethod { lagged, fixed_point } coulomb_method = CoulombMethod::lagged;  // the fixed point's stop on the relative change of phi (coarse meshes: nested_rtol)
+  // how: one Newton solve with the bound phi = F lambda differentiated
+  // (newton) or lagged by one step (lagged: 2x the Tresca work at F = 0.3,
+  // 3.6-4x at F = 0.8) -- if either fails, e.g. oscillates for large F, the
+  // fixed point takes over -- or a fixed point of whole Tresca solves
+  // (coulomb.hpp; 2.8x and 5.6-6.3x)
+  // newton (default): the step differentiates phi = F lambda too
+  // (NewtonOptions::coulomb_newton; measured levels 5-11: 3 steps at F = 0.3,
+  // 4-5 at F = 0.8, 2.1-2.4x and 2.8-3.2x the Tresca work; converges at
+  // F = 1.5 where the lagged bound oscillates)
+  enum class CoulombMethod { lagged, fixed_point, newton } coulomb_method = CoulombMethod::newton;  // the fixed point's stop on the relative change of phi (coarse meshes: nested_rtol)
 };
+
+const char* to_string(RunOptions::CoulombMethod m);  // "lagged", "newton", "fixed_point"
+// "lagged", "newton" or "fixed-point" (also "fixed_point"); throws
+// std::invalid_argument naming `option` otherwise
+RunOptions::CoulombMethod coulomb_method_from(const std::string& s, const std::string& option);
 
 struct RunTimes {
   double nested = 0;  // the coarser meshes' solves of nested iteration

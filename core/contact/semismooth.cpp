@@ -9,6 +9,7 @@
 #include "kernels/contact_maps.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/contact/boundary_preconditioner.hpp"
+#include "core/solvers/gmres.hpp"
 #include "core/util/profile.hpp"
 
 namespace tresca {
@@ -44,11 +45,16 @@ struct InnerWork {
 
 // The reduced Newton system of one step (method.md §4).
 struct ReducedSystem {
-  explicit ReducedSystem(index n3) : known(n3), h(n3), rhs(n3), dlambda(n3 / 3), fixed(n3), free(n3) {}
+  explicit ReducedSystem(index n3)
+      : known(n3), h(n3), rhs(n3), dlambda(n3 / 3), coupling(2 * (n3 / 3)), fixed(n3), free(n3) {}
   std::vector<real> known;  // known increments: Δu_τ = v_12 (sticking), Δu_z = v_4 / s (contact)
   std::vector<real> h;      // H_1 blocks (h11 | h12 | h22) of sliding nodes
   std::vector<real> rhs;    // r_F: (s I + H_1) v_12 on sliding rows, v_3 + v_4 on separated u_z rows
   std::vector<real> dlambda;  // Δλ = v_4 (separated), −v_3 (contact: plus (S Δu)_z)
+  // Coulomb Newton: F t per sliding contact node (2 blocks of p; t = d_12/|d_12|),
+  // the τ rows' coefficient of Δλ = (S Δu)_z − v_3; empty otherwise
+  std::vector<real> coupling;
+  bool coupled = false;
   std::vector<std::uint8_t> fixed, free;  // per dof: increment known / part of F
 };
 
@@ -59,10 +65,20 @@ struct ReducedSystem {
 //   contact: Δu_z = v_4 / s;  separated: Δλ = v_4, (S Δu)_z = v_3 + v_4
 // (s = 1: the paper's (G A + H) Δ = (G + H) v̂). Returns whether any known
 // increment is nonzero.
+//
+// Coulomb (F >= 0, coupled): the step's point on the Coulomb graph has the
+// pressure d_4 and the bound phi = F d_4 (the Newton loop computes d_12 with
+// it). Its friction force moves with the pressure, so the linearised sliding
+// law of a node in contact gains F t (λ_new − d_4), t = d_12/|d_12|:
+//   (S Δu)_τ + H_1 Δu_τ + F t ((S Δu)_z − v_3 − v_4) = (s I + H_1) v_12,
+// λ_new = λ + Δλ with Δλ = (S Δu)_z − v_3: a coupling to the z row of S Δu
+// (L.coupling) and a known term. Separated nodes have phi = F d_4 = 0 and
+// stay uncoupled.
 bool linearise(index p, const ContactConditions& law, const real* scale, const std::vector<real>& u,
                const std::vector<real>& lambda, const std::vector<std::uint8_t>& status, const std::vector<real>& vhat,
-               const std::vector<real>& d, ReducedSystem& L) {
+               const std::vector<real>& d, real coulomb_F, ReducedSystem& L) {
   bool any_known = false;
+  L.coupled = coulomb_F >= 0;
   for (index i = 0; i < p; ++i) {
     const bool stick = status[i] & kStick, contact = status[i] & kContact;
     const real s = scale ? scale[i] : 1;
@@ -83,12 +99,32 @@ bool linearise(index p, const ContactConditions& law, const real* scale, const s
     L.rhs[i] = stick ? 0 : s * v1 + h11 * v1 + h12 * v2;
     L.rhs[p + i] = stick ? 0 : s * v2 + h12 * v1 + h22 * v2;
     L.rhs[2 * p + i] = contact ? 0 : v3 + v4;
+    L.coupling[i] = L.coupling[p + i] = 0;
+    if (L.coupled && !stick && contact) {
+      const real n = std::hypot(d[i], d[p + i]);
+      const real tx = coulomb_F * d[i] / n, ty = coulomb_F * d[p + i] / n;
+      const real dl = -v3 - v4;  // the known part of λ_new − d_4
+      L.rhs[i] -= tx * dl;
+      L.rhs[p + i] -= ty * dl;
+      if (contact) {
+        L.coupling[i] = tx;
+        L.coupling[p + i] = ty;
+      }
+    }
     any_known = any_known || L.known[i] != 0 || L.known[p + i] != 0 || L.known[2 * p + i] != 0;
   }
   return any_known;
 }
 
-// y = mask_F (S x + H x), with S x as the side product: the CG's running
+// y_τ += F t (S x)_z on sliding contact nodes (Coulomb Newton)
+void add_coupling(const ReducedSystem& L, index p, const real* Sx, real* y) {
+  for (index i = 0; i < p; ++i) {
+    y[i] += L.coupling[i] * Sx[2 * p + i];
+    y[p + i] += L.coupling[p + i] * Sx[2 * p + i];
+  }
+}
+
+// y = mask_F (S x + H x) (Coulomb Newton: + F t (S x)_z), with S x as the side product: the CG's running
 // S Δu, whose norm sets the accuracy of the bookkeeping apply of S Δu (step
 // 4). The inner tolerance is this step's own state, relaxed as its outer CG
 // converges.
@@ -108,6 +144,7 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
       y[p + i] = Sx[p + i] + h[p + i] * x[i] + h[2 * p + i] * x[p + i];
       y[2 * p + i] = Sx[2 * p + i];
     }
+    if (L_.coupled) add_coupling(L_, p, Sx, y);
     for (index i = 0; i < 3 * p; ++i)
       if (!L_.free[i]) y[i] = 0;
   }
@@ -146,8 +183,16 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
       out.inner_failed = true;
       return out;
     }
+    if (L.coupled) add_coupling(L, n3 / 3, scratch.data(), scratch.data());  // (τ rows only: z rows untouched)
     for (index i = 0; i < n3; ++i)
       if (L.free[i]) L.rhs[i] -= scratch[i];
+    if (L.coupled) {  // undo: scratch is S Δu_known again, for Sdu below
+      const index p = n3 / 3;
+      for (index i = 0; i < p; ++i) {
+        scratch[i] -= L.coupling[i] * scratch[2 * p + i];
+        scratch[p + i] -= L.coupling[p + i] * scratch[2 * p + i];
+      }
+    }
   } else {
     std::fill(scratch.begin(), scratch.end(), 0.0);
   }
@@ -162,7 +207,23 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
   // like target/|r_j| as the outer residual r_j falls
   co.on_residual = [&](real rn) { A.set_inner_rtol(std::clamp(target / rn, real(1e-12), inner_max)); };
   co.abort_if = [&] { return work.failures > fails0; };  // an S apply is untrustworthy
-  {
+  if (L.coupled) {
+    // not symmetric: GMRES with the same preconditioner. The inner accuracy
+    // is fixed at 0.1 eta: relaxing it as the residual falls, as for CG, cost
+    // 2-4 more Newton steps at level 10 (perf/RESULTS.md). S Δu is not a side
+    // product here (the caller's bookkeeping apply sets its accuracy from
+    // |Δu| instead)
+    GMRESOptions go;
+    go.atol = target;
+    go.rtol = 1e-13;
+    go.restart = 50;
+    go.max_iterations = co.max_iterations;
+    A.set_inner_rtol(std::clamp(0.1 * eta, real(1e-12), inner_max));
+    go.abort_if = co.abort_if;
+    ScopedTimer t(Kernel::outer_cg);
+    out.outer = gmres(A, M, L.rhs.data(), du.data(), go);
+    std::fill(Sdu.begin(), Sdu.end(), 0.0);
+  } else {
     ScopedTimer t(Kernel::outer_cg);
     out.outer = pcg(A, M, L.rhs.data(), du.data(), Sdu.data(), co, ws);
   }
@@ -249,6 +310,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     }
   }
   std::vector<real> r(n3), v(4 * p), d(3 * p), du(n3), Sdu(n3), scratch(n3);
+  std::vector<real> v_at_d(opt.coulomb_newton ? 4 * p : 0);  // (Coulomb Newton: the second step's v̂, not used)
   ReducedSystem L(n3);
   std::unique_ptr<BoundaryPreconditioner> M;
   if (opt.outer_pc == OuterPreconditioner::multigrid)
@@ -259,6 +321,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   std::vector<real> scale;
   if (opt.scaling == StepScaling::diagonal) scale = step_scale(S);
   const real* scale_ptr = scale.empty() ? nullptr : scale.data();
+  real smax = 0;
+  for (real s : (scale.empty() ? step_scale(S) : scale)) smax = std::max(smax, s);
 
   const real bnorm = norm2(n3, btilde.data());
   bool last_step_hit_limit = false;
@@ -273,6 +337,13 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
         for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * std::max(real(0), R.lambda[i]);
       vnorm = std::sqrt(approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), r.data(), v.data(), d.data(),
                                            R.status.data()));
+      if (opt.coulomb >= 0 && opt.coulomb_newton) {
+        // the step's point on the Coulomb graph: its pressure d_4 sets the
+        // bound of its friction force (v̂, the residual, stays at lambda)
+        for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * d[2 * p + i];
+        approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), r.data(), v_at_d.data(), d.data(),
+                           R.status.data());
+      }
     }
     R.history.push_back(vnorm);
     R.inner_history.push_back(work.iterations);
@@ -293,7 +364,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     if (stagnated(R.history, opt.stagnation_window)) return finish(NewtonReason::stagnation);
 
     // 2. linearisation: known increments, free set, H, right-hand side
-    const bool any_known = linearise(p, law, scale_ptr, R.u, R.lambda, R.status, v, d, L);
+    const bool any_known = linearise(p, law, scale_ptr, R.u, R.lambda, R.status, v, d,
+                                     opt.coulomb >= 0 && opt.coulomb_newton ? opt.coulomb : real(-1), L);
     // Forcing term (Eisenstat–Walker, choice 2, safeguarded): the step is
     // solved to eta_k relative, eta_k -> 0 as |v̂| falls (superlinear).
     if (k > 0) {
@@ -319,7 +391,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     // later residual. One application of S to the whole Δu, to an absolute
     // accuracy of book_accuracy |b̃| (relative to the CG's estimate of S Δu).
     for (index i = 0; i < n3; ++i) du[i] += L.known[i];
-    const real sdu_norm = norm2(n3, Sdu.data());
+    // |S Δu| from the CG's side product, or (GMRES) bounded by max s |Δu|
+    const real sdu_norm = L.coupled ? smax * norm2(n3, du.data()) : norm2(n3, Sdu.data());
     const real book_rtol =
         sdu_norm > 0 ? std::clamp(opt.book_accuracy * bnorm / sdu_norm, real(1e-12), real(1e-1)) : real(1e-1);
     R.operator_applications += 1;

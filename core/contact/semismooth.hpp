@@ -104,6 +104,11 @@ struct NewtonOptions {
   // residual, so the stopping rule stays; the Newton step does not
   // differentiate phi (a quasi-Newton step, still symmetric). < 0: Tresca.
   real coulomb = -1;
+  // with coulomb >= 0: the Newton step also differentiates phi_i = F lambda_i
+  // (a sliding node's friction force F lambda t moves with lambda): the
+  // semismooth* Newton step of the Coulomb problem itself, not symmetric, so
+  // solved by boundary GMRES with the same preconditioner (semismooth.cpp)
+  bool coulomb_newton = false;
 };
 
 struct NewtonResult {

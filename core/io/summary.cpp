@@ -38,7 +38,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   if (R.coulomb) {
     const CoulombResult& C = R.coulomb_loop;
     coulomb = {{"F", opt.coulomb},
-               {"method", opt.coulomb_method == RunOptions::CoulombMethod::lagged ? "lagged" : "fixed_point"},
+               {"method", to_string(opt.coulomb_method)},
                {"fallback_to_fixed_point", R.coulomb_fallback},
                {"fixed_point_iterations", C.iterations},
                {"reason", to_string(C.reason)},

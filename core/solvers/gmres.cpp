@@ -65,6 +65,10 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
       A.apply(Z[j].data(), w.data());
       st.operator_applications += 1;
       st.iterations += 1;
+      if (opt.abort_if && opt.abort_if()) {
+        st.reason = SolveReason::aborted;
+        return st;
+      }
       for (int i = 0; i <= j; ++i) {
         h(i, j) = dot(n, w.data(), V[i].data());
         axpy(n, -h(i, j), V[i].data(), w.data());

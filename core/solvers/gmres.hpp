@@ -15,6 +15,7 @@
 // storage, so M may vary between applications). Work per inner step: 1 apply
 // of A and of M, j + 1 dots and axpys of length n at step j.
 #pragma once
+#include <functional>
 #include <vector>
 
 #include "core/solvers/cg.hpp"
@@ -27,6 +28,9 @@ struct GMRESOptions {
   int restart = 30;           // m
   int max_iterations = 1000;  // inner steps over all cycles
   bool zero_initial_guess = true;
+  // polled after each application of A: true stops with `aborted` (e.g. an
+  // inexact A whose own inner solve failed)
+  std::function<bool()> abort_if;
 };
 
 SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b, real* x, const GMRESOptions& opt);
