@@ -5,7 +5,7 @@
 
 writes, for what it is given:
   DIR/residual.png  the Newton residual history |v| (log scale) with the
-                    cumulative inner and outer CG iterations (from tresca --json)
+                    cumulative inner CG and outer CG or GMRES iterations (from tresca --json)
   DIR/contact.png   the contact face: separated / stick / slip, the contact
                     pressure lambda / nodal area, slip vectors (from --contact-csv)
   DIR/scaling.png   time and work per level against dofs, log-log, with the
@@ -50,8 +50,8 @@ def residual(run, out):
     inner, outer = run.get("inner_iterations_history"), run.get("outer_iterations_history")
     if inner and outer:
         ax2 = ax.twinx()
-        ax2.plot(k, inner, "s:", color="tab:orange", label="inner CG (cumulative)")
-        ax2.plot(k, outer, "^:", color="tab:green", label="outer CG (cumulative)")
+        ax2.plot(k, inner, "s:", color="tab:orange", label="inner MG-CG (cumulative)")
+        ax2.plot(k, outer, "^:", color="tab:green", label="outer CG or GMRES (cumulative)")
         ax2.set_ylabel("Krylov iterations")
         lines = ax.get_legend_handles_labels()
         lines2 = ax2.get_legend_handles_labels()
