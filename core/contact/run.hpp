@@ -68,7 +68,7 @@ struct RunOptions {
   // (coulomb.hpp; 2.8x and 5.6-6.3x)
   // newton (default): the step differentiates phi = F lambda too
   // (NewtonOptions::coulomb_newton; measured levels 5-11: 3 steps at F = 0.3,
-  // 4-5 at F = 0.8, 2.0-2.2x and 2.5-3.1x the Tresca work; converges at
+  // 4-5 at F = 0.8, 1.6-1.8x and 2.1-2.8x the Tresca work; converges at
   // F = 1.5 where the lagged bound oscillates)
   enum class CoulombMethod { lagged, fixed_point, newton } coulomb_method = CoulombMethod::newton;  // the fixed point's stop on the relative change of phi (coarse meshes: nested_rtol)
 };
