@@ -52,7 +52,7 @@ struct ReducedSystem {
   std::vector<real> rhs;    // r_F: (s I + H_1) v_12 on sliding rows, v_3 + v_4 on separated u_z rows
   std::vector<real> dlambda;  // Δλ = v_4 (separated), −v_3 (contact: plus (S Δu)_z)
   // Coulomb Newton: F t per sliding contact node (2 blocks of p; t = d_12/|d_12|),
-  // the τ rows' coefficient of Δλ = (S Δu)_z − v_3; empty otherwise
+  // the τ rows' coefficient of (S Δu)_z; zero on all other nodes
   std::vector<real> coupling;
   bool coupled = false;
   std::vector<std::uint8_t> fixed, free;  // per dof: increment known / part of F
@@ -106,10 +106,8 @@ bool linearise(index p, const ContactConditions& law, const real* scale, const s
       const real dl = -v3 - v4;  // the known part of λ_new − d_4
       L.rhs[i] -= tx * dl;
       L.rhs[p + i] -= ty * dl;
-      if (contact) {
-        L.coupling[i] = tx;
-        L.coupling[p + i] = ty;
-      }
+      L.coupling[i] = tx;
+      L.coupling[p + i] = ty;
     }
     any_known = any_known || L.known[i] != 0 || L.known[p + i] != 0 || L.known[2 * p + i] != 0;
   }
@@ -124,7 +122,7 @@ void add_coupling(const ReducedSystem& L, index p, const real* Sx, real* y) {
   }
 }
 
-// y = mask_F (S x + H x) (Coulomb Newton: + F t (S x)_z), with S x as the side product: the CG's running
+// y = mask_F (S x + H x (+ F t (S x)_z: Coulomb Newton)), with S x as the side product: the CG's running
 // S Δu, whose norm sets the accuracy of the bookkeeping apply of S Δu (step
 // 4). The inner tolerance is this step's own state, relaxed as its outer CG
 // converges.
@@ -183,15 +181,13 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
       out.inner_failed = true;
       return out;
     }
-    if (L.coupled) add_coupling(L, n3 / 3, scratch.data(), scratch.data());  // (τ rows only: z rows untouched)
     for (index i = 0; i < n3; ++i)
       if (L.free[i]) L.rhs[i] -= scratch[i];
-    if (L.coupled) {  // undo: scratch is S Δu_known again, for Sdu below
-      const index p = n3 / 3;
-      for (index i = 0; i < p; ++i) {
-        scratch[i] -= L.coupling[i] * scratch[2 * p + i];
-        scratch[p + i] -= L.coupling[p + i] * scratch[2 * p + i];
-      }
+    if (L.coupled) {  // ... and its F t (S Δu_known)_z on the coupled rows
+      std::vector<real> c(n3, 0.0);
+      add_coupling(L, n3 / 3, scratch.data(), c.data());
+      for (index i = 0; i < n3; ++i)
+        if (L.free[i]) L.rhs[i] -= c[i];
     }
   } else {
     std::fill(scratch.begin(), scratch.end(), 0.0);
@@ -321,8 +317,9 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   std::vector<real> scale;
   if (opt.scaling == StepScaling::diagonal) scale = step_scale(S);
   const real* scale_ptr = scale.empty() ? nullptr : scale.data();
-  real smax = 0;
-  for (real s : (scale.empty() ? step_scale(S) : scale)) smax = std::max(smax, s);
+  real smax = 0;  // Coulomb Newton: bounds |S Δu| by smax |Δu| for the bookkeeping apply
+  if (opt.coulomb_newton)
+    for (real s : (scale.empty() ? step_scale(S) : scale)) smax = std::max(smax, s);
 
   const real bnorm = norm2(n3, btilde.data());
   bool last_step_hit_limit = false;
