@@ -2,9 +2,11 @@
 // checks on their parameters, and contact where, and as much as, they allow.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "core/contact/run.hpp"
+#include "kernels/contact_maps.hpp"
 
 namespace tresca {
 
@@ -73,6 +75,57 @@ TEST(Obstacle, SphereContactStaysOverTheSphereAndGrowsWithTheLoad) {
     EXPECT_LT(rho_max, 2.0);
     EXPECT_LT(R.report.uz_violation, 1e-12);
     previous = R.report.active;
+  }
+}
+
+// Contact patch test (issue 10). A uniform state that the clamped face
+// x = 0 allows: uniaxial strain u = (a (x - x0), 0, 0), a < 0, held by the
+// tractions of its stress on x1, y0, y1 and z1 (sigma_xx = (lambda + 2 mu) a,
+// sigma_yy = sigma_zz = lambda a). The block is pressed onto the plane with
+// the uniform pressure p = -lambda a, and its bottom slides (u_x = a x) with
+// zero shear, which frictionless contact (phi = 0) allows. Trilinear
+// elements hold linear fields exactly, so the discrete solution is exact:
+// every contact node in contact and sliding, its force p times its nodal
+// area (edges half, corners a quarter), u = (a x, 0, 0) in the whole body.
+// (Stick and slip under a tangential traction need a block free to slide:
+// with x = 0 clamped no uniform state has friction on the bottom.)
+TEST(ContactPatch, UniformPressureGivesNodalForcesOfPressureTimesArea) {
+  for (const auto& dims : {std::array<index, 3>{8, 4, 4}, std::array<index, 3>{7, 3, 5}}) {
+    ProblemSpec spec = spec_for_dims(dims[0], dims[1], dims[2]);
+    spec.phi = 0;
+    const real a = -1e-3;
+    const real lam = spec.E * spec.nu / ((1 + spec.nu) * (1 - 2 * spec.nu)), mu = spec.E / (2 * (1 + spec.nu));
+    const real sxx = (lam + 2 * mu) * a, syy = lam * a, szz = lam * a;
+    spec.traction[kLoadX1] = {sxx, 0, 0};
+    spec.traction[kLoadY0] = {0, -syy, 0};
+    spec.traction[kLoadY1] = {0, syy, 0};
+    spec.traction[kLoadZ1] = {0, 0, szz};
+    spec.body_force = {0, 0, 0};
+    const RunResult R = run_tresca(spec, RunOptions{});
+    ASSERT_TRUE(R.converged()) << R.reason();
+    const Problem& P = *R.problem;
+    const GridDims& g = P.grid;
+    const index p = P.contact_nodes(), N = g.nodes();
+    const real pressure = -szz, ux_max = std::abs(a) * spec.lx;
+    for (index c = 0; c < p; ++c) {
+      const index ix = 1 + c % g.ex, iy = c / g.ex;
+      const real area = g.hx() * g.hy() * (ix == g.ex ? 0.5 : 1) * ((iy == 0 || iy == g.ey) ? 0.5 : 1);
+      EXPECT_NEAR(R.newton.lambda[c], pressure * area, 1e-8 * pressure * area) << "node " << ix << "," << iy;
+      EXPECT_NEAR(R.newton.u[c], a * ix * g.hx(), 1e-8 * ux_max);
+      EXPECT_NEAR(R.newton.u[p + c], 0, 1e-8 * ux_max);
+      EXPECT_NEAR(R.newton.u[2 * p + c], 0, 1e-8 * ux_max);
+      EXPECT_NEAR(R.report.r[c], 0, 1e-8 * pressure * area);  // no friction force
+      EXPECT_TRUE(R.report.status[c] & kContact);
+      EXPECT_FALSE(R.report.status[c] & kStick);
+    }
+    for (index iz = 0; iz < g.nz(); ++iz)
+      for (index iy = 0; iy < g.ny(); ++iy)
+        for (index ix = 0; ix < g.nx(); ++ix) {
+          const index n = g.node(ix, iy, iz);
+          ASSERT_NEAR(R.u_full[n], a * ix * g.hx(), 1e-8 * ux_max) << ix << "," << iy << "," << iz;
+          ASSERT_NEAR(R.u_full[N + n], 0, 1e-8 * ux_max);
+          ASSERT_NEAR(R.u_full[2 * N + n], 0, 1e-8 * ux_max);
+        }
   }
 }
 
