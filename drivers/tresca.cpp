@@ -345,6 +345,8 @@ int main(int argc, char** argv) {
                     R.coulomb_consistency);
       }
     }
+    if (R.metric_fallback)
+      std::printf("Newton in the diagonal metric stagnated; the run was redone in the paper's metric from x0 = 0\n");
     std::printf("%s after %d Newton iterations (reason: %s), final |v| %s (eps %.1e)\n",
                 N.converged() ? "converged" : "NOT CONVERGED", N.iterations, to_string(N.reason), last,
                 opt.newton.eps);

@@ -175,6 +175,26 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     F.times.total += R.times.total;
     return F;
   }
+  // Tresca in the diagonal metric can cycle between two active sets where
+  // the paper's metric converges (measured: 8x4x4 under pressure and shear
+  // with phi_i = 2 |b̃_τ,i|: a 2-cycle against 4 steps); no line search in
+  // either, so the other metric is the globalisation
+  if (!R.coulomb && R.newton.reason == NewtonReason::stagnation && opt.newton.scaling == StepScaling::diagonal) {
+    RunOptions f = opt;
+    const NewtonOptions paper = NewtonOptions::paper_method();
+    f.newton.scaling = paper.scaling;
+    f.newton.forcing_max = paper.forcing_max;
+    f.newton.u0 = f.newton.lambda0 = nullptr;
+    f.newton.Su0 = nullptr;
+    f.newton.extension0 = nullptr;
+    f.nested = false;
+    if (opt.phase_done) opt.phase_done("Newton in the diagonal metric stagnated; again in the paper's", R.times.total);
+    RunResult P = run_tresca(spec, f);
+    P.metric_fallback = true;
+    P.fine_matvecs_total += R.fine_matvecs_total;
+    P.times.total += R.times.total;
+    return P;
+  }
   return R;
 }
 

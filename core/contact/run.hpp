@@ -91,7 +91,11 @@ struct RunResult {
   // Coulomb: the fixed point's account (its `last` moved into newton)
   bool coulomb = false;
   CoulombResult coulomb_loop;
-  bool coulomb_fallback = false;  // the lagged bound failed; the fixed point took over
+  bool coulomb_fallback = false;  // one Newton solve failed; the fixed point took over
+  // Tresca: Newton in the diagonal metric stagnated (it can cycle between
+  // two active sets from x0 = 0), and the paper's metric with near-exact
+  // steps took over from x0 = 0 (its work and time included)
+  bool metric_fallback = false;
   real coulomb_consistency = 0;  // max_i |phi_i - F lambda_i| at the solution [N]
   bool converged() const { return newton.converged() && (!coulomb || coulomb_loop.converged()); }
   std::string reason() const {

@@ -64,6 +64,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["mg_precision"] = to_string(opt.mg.precision);
   j["newton_iterations"] = N.iterations;
   j["converged"] = R.converged();
+  j["fallback_to_paper_metric"] = R.metric_fallback;
   j["reason"] = R.reason();
   j["residual_history"] = N.history;
   j["inner_iterations_history"] = N.inner_history;
