@@ -64,7 +64,7 @@ const char* kHelp =
     "                     FILE_levelL.vtu, FILE_levelL_contact.vtu per level and FILE.pvd to play them\n"
     "  --vtk-every-iteration  with --vtk: also FILE_itK.vtu (+ _contact) at every Newton iterate K\n"
     "                     of the fine mesh and FILE.pvd to play them in ParaView (one extra S apply each)\n"
-    "  --vtk-format binary|ascii  VTU encoding: zlib-compressed appended binary (default) or text\n"
+    "  --vtk-format binary|ascii  VTU encoding: LZMA-compressed appended binary (default) or text\n"
     "  --table A-B        solve levels A..B and print the paper's Table 1 columns\n"
     "  --profile          per-kernel time, GB/s and GFLOP/s after the run\n"
     "  --quiet            no progress lines\n"

@@ -9,8 +9,7 @@
 namespace tresca {
 
 FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
-                         const NewtonResult& R, real tight_rtol, std::vector<real>* extension, bool warm,
-                         StepScaling scaling) {
+                         const NewtonResult& R, real tight_rtol, std::vector<real>* extension, bool warm) {
   const index p = S.size() / 3;
   const std::vector<real>& phi = law.phi;
   FinalReport F;
@@ -22,10 +21,9 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
   for (index i = 0; i < 3 * p; ++i) F.r[i] = Su[i] - btilde[i];
   F.status.resize(p);
   // the residual is the paper's |v̂| either way; the status (which nodes are
-  // in contact, which stick) is decided in Newton's metric, so that it does
-  // not depend on the units where a node is on the edge of two states
-  const std::vector<real> scale = scaling == StepScaling::diagonal ? step_scale(S) : std::vector<real>{};
-  F.true_residual = std::sqrt(approximation_step(p, law.law(), scale.empty() ? nullptr : scale.data(), R.u.data(), R.lambda.data(), F.r.data(), v.data(),
+  // in contact, which stick) is decided in Newton's metric R.scale, so that
+  // it does not depend on the units where a node is on the edge of two states
+  F.true_residual = std::sqrt(approximation_step(p, law.law(), R.scale.empty() ? nullptr : R.scale.data(), R.u.data(), R.lambda.data(), F.r.data(), v.data(),
                                                  d.data(), F.status.data()));
   F.btilde_norm = norm2(3 * p, btilde.data());
   F.true_residual_relative = F.btilde_norm > 0 ? F.true_residual / F.btilde_norm : F.true_residual;

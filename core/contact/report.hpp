@@ -30,10 +30,10 @@ struct FinalReport {
 };
 
 // extension (optional): E u (3N SoA) from the same tight solve; with
-// `warm`, it holds an initial guess of E u on entry. `scaling`: the metric
-// in which the status is decided (Newton's, NewtonOptions::scaling).
+// `warm`, it holds an initial guess of E u on entry. The status is decided
+// in the metric of R's steps (NewtonResult::scale).
 FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
                          const NewtonResult& R, real tight_rtol = 1e-12, std::vector<real>* extension = nullptr,
-                         bool warm = false, StepScaling scaling = StepScaling::diagonal);
+                         bool warm = false);
 
 }  // namespace tresca

@@ -141,7 +141,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   // the final check's tight S u, warm from E u0 when there is one, also
   // gives E u: u = E u + K_ii^{-1} l_i
   const bool warm = !extension.empty();
-  R.report = final_report(S, btilde, R.contact, R.newton, opt.tight_rtol, &extension, warm, newton.scaling);
+  R.report = final_report(S, btilde, R.contact, R.newton, opt.tight_rtol, &extension, warm);
   if (opt.recover_interior) {
     R.u_full = std::move(extension);
     axpy(index(R.u_full.size()), 1, R.interior_load.data(), R.u_full.data());

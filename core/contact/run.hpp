@@ -60,17 +60,17 @@ struct RunOptions {
   // Coulomb friction (coulomb.hpp): coefficient F >= 0 makes the bound
   // phi_i = F lambda_i (contact.phi / spec.phi are then not used); < 0: Tresca
   real coulomb = -1;
-  real coulomb_tol = 1e-6;
-  // how: one Newton solve with the bound phi = F lambda differentiated
-  // (newton) or lagged by one step (lagged: 2x the Tresca work at F = 0.3,
-  // 3.6-4x at F = 0.8) -- if either fails, e.g. oscillates for large F, the
-  // fixed point takes over -- or a fixed point of whole Tresca solves
-  // (coulomb.hpp; 2.8x and 5.6-6.3x)
-  // newton (default): the step differentiates phi = F lambda too
-  // (NewtonOptions::coulomb_newton; measured levels 5-11: 3 steps at F = 0.3,
-  // 4-5 at F = 0.8, 1.6-1.8x and 2.1-2.8x the Tresca work; converges at
-  // F = 1.5 where the lagged bound oscillates)
-  enum class CoulombMethod { lagged, fixed_point, newton } coulomb_method = CoulombMethod::newton;  // the fixed point's stop on the relative change of phi (coarse meshes: nested_rtol)
+  real coulomb_tol = 1e-6;  // the fixed point's stop on the relative change of phi (coarse meshes: nested_rtol)
+  // How, measured on levels 5-11 (perf/RESULTS.md §0e):
+  // - newton (default): one Newton solve whose step differentiates
+  //   phi = F lambda (NewtonOptions::coulomb_newton): 3 steps at F = 0.3,
+  //   4-5 at F = 0.8, 1.6-1.8x and 2.1-2.8x the Tresca work; converges at
+  //   F = 1.5 where the lagged bound oscillates;
+  // - lagged: one Newton solve with the bound a step late: 2x the Tresca
+  //   work at F = 0.3, 3.6-4x at F = 0.8;
+  // - fixed_point: whole Tresca solves (coulomb.hpp; 2.8x and 5.6-6.3x).
+  // If one Newton solve fails the fixed point takes over (run.cpp).
+  enum class CoulombMethod { lagged, fixed_point, newton } coulomb_method = CoulombMethod::newton;
 };
 
 const char* to_string(RunOptions::CoulombMethod m);  // "lagged", "newton", "fixed_point"

@@ -119,6 +119,7 @@ struct NewtonResult {
   std::vector<real> u, lambda, Su;     // 3p, p, 3p
   std::vector<std::uint8_t> status;    // per node: kContact | kStick at the last approximation step
   std::vector<real> phi;               // the Tresca bound of the last approximation step
+  std::vector<real> scale;             // the steps' metric s_i (step_scale), empty: the paper's (s = 1)
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
   int outer_limit_hits = 0;  // Newton steps whose outer CG stopped at its iteration limit
   // work in fine-grid matvec equivalents, from the solvers' own counts and

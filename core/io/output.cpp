@@ -172,16 +172,6 @@ void OutputSet::publish() {
   files_.clear();
 }
 
-namespace {
-
-// a file of an OutputSet, for the writers' f.get() calls
-struct OutputHandle {
-  std::FILE* f;
-  std::FILE* get() const { return f; }
-};
-
-}  // namespace
-
 std::string path_stem(const std::string& path) {
   const auto slash = path.find_last_of('/');
   const auto dot = path.find_last_of('.');
@@ -240,15 +230,16 @@ void write_file_atomic(const std::string& path, const std::string& contents) {
 std::string json_text(const Json& j) { return j.dump(1) + "\n"; }
 
 void write_contact_csv(OutputSet& out, const std::string& path, const Problem& P, const ContactFields& c) {
-  OutputHandle f{out.create(path)};
+  std::FILE* f = out.create(path);  // owned by the set
   const index p = P.contact_nodes();
   const GridDims& g = P.grid;
-  std::fprintf(f.get(), "ix,iy,x,y,ux,uy,uz,lambda,phi,gap,contact,stick\n");
+  std::fprintf(f, "ix,iy,x,y,ux,uy,uz,lambda,phi,gap,contact,stick\n");
   for (index i = 0; i < p; ++i) {
     const index ix = 1 + i % g.ex, iy = i / g.ex;
+    const auto [x, y] = contact_position(g, i);
     const std::uint8_t s = (*c.status)[i];
-    std::fprintf(f.get(), "%lld,%lld,%.10g,%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d,%d\n", (long long)ix,
-                 (long long)iy, g.x0 + ix * g.hx(), g.y0 + iy * g.hy(), (*c.u)[i], (*c.u)[p + i], (*c.u)[2 * p + i],
+    std::fprintf(f, "%lld,%lld,%.10g,%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d,%d\n", (long long)ix,
+                 (long long)iy, x, y, (*c.u)[i], (*c.u)[p + i], (*c.u)[2 * p + i],
                  (*c.lambda)[i], (*c.phi)[i], (*c.gap)[i], (s & kContact) ? 1 : 0, (s & kStick) ? 1 : 0);
   }
 }
