@@ -204,24 +204,26 @@ template ElasticityStencilT<float> stencil_in_precision<float>(const ElasticityS
 template ElasticityStencilT<double> stencil_in_precision<double>(const ElasticityStencil&);
 
 template <class T>
-void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_begin, index z_end, const T* b) {
-  TRESCA_ASSERT(0 <= z_begin && z_begin <= z_end && z_end <= k.g.nz());
-  TRESCA_ASSERT(x != y && (b == nullptr || b != y));  // y is written while x and b are read
-  TRESCA_ASSERT(!k.groups.empty());
+void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const RowBlock& rows, const T* b) {
   const GridDims& g = k.g;
   const index nx = g.nx(), ny = g.ny(), N = g.nodes();
+  TRESCA_ASSERT(0 <= rows.z_begin && rows.z_begin <= rows.z_end && rows.z_end <= g.nz());
+  TRESCA_ASSERT(0 <= rows.y_begin && rows.y_begin <= rows.y_end && rows.y_end <= ny);
+  TRESCA_ASSERT(x != y && (b == nullptr || b != y));  // y is written while x and b are read
+  TRESCA_ASSERT(!k.groups.empty());
   const index nruns = index(k.run_begin.size()) - 1;
   // Cache blocking: each thread sweeps z over a band of about kBand x-rows, so
   // the three input planes of the band (3 x (kBand+2) rows) stay in L2.
   constexpr index kBand = 16;
+  const index rows_y = rows.y_end - rows.y_begin;
   const index nthreads = omp_get_max_threads();
-  const index nbands = std::max<index>(1, nthreads * ((ny + nthreads * kBand - 1) / (nthreads * kBand)));
-  const index band = (ny + nbands - 1) / nbands;
-  const double nodes = double(nx) * double(ny) * double(z_end - z_begin);
+  const index nbands = std::max<index>(1, nthreads * ((rows_y + nthreads * kBand - 1) / (nthreads * kBand)));
+  const index band = (rows_y + nbands - 1) / nbands;
+  const double nodes = double(nx) * double(rows_y) * double(rows.z_end - rows.z_begin);
 #pragma omp parallel for schedule(static) if (worth_threads(nodes * in_precision<T>(kApplyCost)))
   for (index bnd = 0; bnd < nbands; ++bnd)
-    for (index iz = z_begin; iz < z_end; ++iz)
-      for (index iy = bnd * band; iy < std::min(ny, (bnd + 1) * band); ++iy) {
+    for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
+      for (index iy = rows.y_begin + bnd * band; iy < std::min(rows.y_end, rows.y_begin + (bnd + 1) * band); ++iy) {
         const std::uint8_t cy = k.cls[1][iy], cz = k.cls[2][iz];
         const index row = nx * (iy + ny * iz);
         const bool row_fixed = (cy & kSelf) || (cz & kSelf);
@@ -240,6 +242,15 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_
           stencil_range<T>(k.groups.data(), k.first.data() + 7 * s, x + row, y + row, b ? b + row : nullptr, N, i0, i1);
         }
       }
+}
+template void elasticity_apply<double>(const ElasticityStencilT<double>&, const double*, double*, const RowBlock&,
+                                       const double*);
+template void elasticity_apply<float>(const ElasticityStencilT<float>&, const float*, float*, const RowBlock&,
+                                      const float*);
+
+template <class T>
+void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_begin, index z_end, const T* b) {
+  elasticity_apply(k, x, y, RowBlock{z_begin, z_end, 0, k.g.ny()}, b);
 }
 template void elasticity_apply<double>(const ElasticityStencilT<double>&, const double*, double*, index, index,
                                        const double*);

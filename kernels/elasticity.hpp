@@ -86,6 +86,14 @@ constexpr Cost kResidualCost{72, 309};
 template <class T>
 void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_begin, index z_end,
                       const T* b = nullptr);
+// The same for a block of node rows: planes [z_begin, z_end) x rows
+// [y_begin, y_end), all of x (a rank's interior rows while its ghost rows
+// are in flight, core/parallel/distributed_elasticity.hpp).
+struct RowBlock {
+  index z_begin, z_end, y_begin, y_end;
+};
+template <class T>
+void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const RowBlock& rows, const T* b = nullptr);
 void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
                           const real* b = nullptr);
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "kernels/vector_ops.hpp"
+#include "core/parallel/comm.hpp"
 #include "core/util/profile.hpp"
 
 namespace tresca {
@@ -38,6 +39,8 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
   if (side) ws.s.resize(side->side_size());
   real *r = ws.r.data(), *z = ws.z.data(), *p = ws.p.data(), *q = ws.q.data(), *sp = ws.s.data();
   SolveStats st;
+  // local sums -> the sum over all ranks (identity on one rank)
+  auto global = [&](real local) { return opt.comm ? opt.comm->sum(local) : local; };
   auto apply = [&](const real* in, real* out) {
     st.operator_applications += 1;
     if (side)
@@ -45,7 +48,7 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     else
       A.apply(in, out);
   };
-  st.rhs_norm = norm2(n, b);
+  st.rhs_norm = std::sqrt(global(dot(n, b, b)));
   if (opt.zero_initial_guess) {
     fill<real>(n, 0, x);
     copy(n, b, r);
@@ -56,7 +59,7 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     copy(n, b, r);
     axpy(n, -1, q, r);
   }
-  real rr = dot(n, r, r);
+  real rr = global(dot(n, r, r));
   st.initial_residual = st.residual = std::sqrt(rr);
   const real target = std::max(opt.rtol * st.rhs_norm, opt.atol);
   if (!std::isfinite(rr)) {
@@ -74,7 +77,7 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
   };
   precondition();
   copy(n, z, p);
-  real rz = dot(n, r, z);
+  real rz = global(dot(n, r, z));
   for (int it = 1; it <= opt.max_iterations; ++it) {
     if (!(rz > 0)) {
       st.reason = std::isfinite(rz) ? SolveReason::breakdown : SolveReason::non_finite;
@@ -88,7 +91,7 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     real pq;
     {
       ScopedTimer t(Kernel::vector, n * kDotCost);
-      pq = dot(n, p, q);
+      pq = global(dot(n, p, q));
     }
     if (!(pq > 0)) {
       st.reason = std::isfinite(pq) ? SolveReason::breakdown : SolveReason::non_finite;
@@ -98,7 +101,7 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     if (side) axpy(side->side_size(), alpha, sp, side_x);
     {
       ScopedTimer t(Kernel::vector, n * kCgUpdateCost);
-      rr = cg_update(n, alpha, p, q, x, r);
+      rr = global(cg_update(n, alpha, p, q, x, r));
     }
     st.iterations = it;
     st.residual = std::sqrt(rr);
@@ -110,7 +113,7 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     if (opt.on_residual) opt.on_residual(st.residual);
     precondition();
     ScopedTimer t(Kernel::vector, n * (kDotCost + kXpayCost));
-    const real rz_new = dot(n, r, z);
+    const real rz_new = global(dot(n, r, z));
     xpay(n, z, rz_new / rz, p);
     rz = rz_new;
   }

@@ -18,6 +18,8 @@
 
 namespace tresca {
 
+class Comm;
+
 enum class SolveReason { converged, max_iterations, breakdown, non_finite, aborted };
 const char* to_string(SolveReason r);
 
@@ -42,6 +44,9 @@ struct CGOptions {
   std::function<void(real rnorm)> on_residual;
   // checked after every application of A; true stops with reason aborted
   std::function<bool()> abort_if;
+  // the ranks over which the vectors are distributed (core/parallel/comm.hpp):
+  // every dot product is the sum of the ranks' local ones. Null: one rank.
+  const Comm* comm = nullptr;
 };
 
 // Work vectors kept by the caller so repeated solves do not allocate.

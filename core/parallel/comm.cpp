@@ -1,0 +1,97 @@
+#include "core/parallel/comm.hpp"
+
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
+#ifdef TRESCA_HAVE_MPI
+#include <mpi.h>
+#endif
+
+namespace tresca {
+
+namespace {
+Comm& world_instance() {
+  static Comm c;
+  return c;
+}
+}  // namespace
+
+const Comm& Comm::world() { return world_instance(); }
+
+bool mpi_enabled() {
+#ifdef TRESCA_HAVE_MPI
+  return true;
+#else
+  return false;
+#endif
+}
+
+MpiSession::MpiSession(int& argc, char**& argv) {
+#ifdef TRESCA_HAVE_MPI
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  if (provided < MPI_THREAD_FUNNELED) throw std::runtime_error("MPI does not provide MPI_THREAD_FUNNELED");
+  Comm& c = world_instance();
+  MPI_Comm_rank(MPI_COMM_WORLD, &c.rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &c.size_);
+#else
+  (void)argc;
+  (void)argv;
+#endif
+}
+
+MpiSession::~MpiSession() {
+#ifdef TRESCA_HAVE_MPI
+  MPI_Finalize();
+#endif
+}
+
+real Comm::sum(real local) const {
+#ifdef TRESCA_HAVE_MPI
+  if (size_ > 1) {
+    real global = 0;
+    MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    return global;
+  }
+#endif
+  return local;
+}
+
+void Comm::sum(real* values, int n) const {
+#ifdef TRESCA_HAVE_MPI
+  if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+#else
+  (void)values;
+  (void)n;
+#endif
+}
+
+double Comm::max(double local) const {
+#ifdef TRESCA_HAVE_MPI
+  if (size_ > 1) {
+    double global = 0;
+    MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    return global;
+  }
+#endif
+  return local;
+}
+
+void Comm::barrier() const {
+#ifdef TRESCA_HAVE_MPI
+  if (size_ > 1) MPI_Barrier(MPI_COMM_WORLD);
+#endif
+}
+
+int launched_ranks() {
+  for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"}) {
+    if (const char* v = std::getenv(var)) {
+      const int n = std::atoi(v);
+      if (n > 0) return n;
+    }
+  }
+  return 1;
+}
+
+}  // namespace tresca

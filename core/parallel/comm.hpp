@@ -1,0 +1,51 @@
+// The ranks of a run: MPI_COMM_WORLD when the build has MPI (CMake option
+// TRESCA_MPI, macro TRESCA_HAVE_MPI), otherwise one rank. OpenMP threads run
+// inside each rank (MPI_THREAD_FUNNELED: only the thread that called
+// MpiSession talks to MPI).
+//
+// Reductions: each rank sums its own entries in a fixed order (the
+// kernels' blocked sums, independent of the thread count), then
+// MPI_Allreduce combines the ranks' partial sums; with one rank the result
+// is the local sum itself, bit for bit.
+#pragma once
+#include <vector>
+
+#include "kernels/types.hpp"
+
+namespace tresca {
+
+class Comm {
+ public:
+  // the world of this process: MPI_COMM_WORLD if MPI is initialised, else one rank
+  static const Comm& world();
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  bool distributed() const { return size_ > 1; }
+  real sum(real local) const;
+  void sum(real* values, int n) const;  // in place, element by element
+  double max(double local) const;
+  void barrier() const;
+
+ private:
+  int rank_ = 0, size_ = 1;
+  friend class MpiSession;
+};
+
+// MPI_Init_thread / MPI_Finalize around main (RAII). Without MPI: nothing.
+class MpiSession {
+ public:
+  MpiSession(int& argc, char**& argv);
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+};
+
+// whether this build talks MPI (TRESCA_HAVE_MPI)
+bool mpi_enabled();
+
+// How many ranks the process launcher started, from its environment
+// (Open MPI, MPICH), whether or not this build has MPI: lets a
+// program that is not distributed refuse to run as several copies of itself.
+int launched_ranks();
+
+}  // namespace tresca

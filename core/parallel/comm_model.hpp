@@ -1,0 +1,55 @@
+// The communication model of the domain-decomposed solver (issue 12, item
+// 5): messages and bytes per rank for one apply, one V-cycle and one
+// MG-preconditioned CG iteration, as functions of the mesh and the rank
+// grid px x py (boxes in x and y; slabs are px = 1), and a time from an
+// assumed network (latency alpha, bandwidth beta per rank).
+//
+// Per apply, an interior rank exchanges one ghost layer with its 4 face
+// neighbours (a plane of ny/py x nz or nx/px x nz nodes) and 4 edge
+// neighbours (a column of nz nodes: the 27-point stencil reaches across
+// corners), 3 doubles per node. Slab ranks (px = 1) have 2 face neighbours.
+// A V-cycle of Chebyshev degree d costs on each level 2d + 1 applies
+// (smoother and residual) and one exchange before each of the restriction and
+// the prolongation; levels with fewer than `agglomerate_nodes` nodes per
+// rank are gathered onto one rank (two collectives of the level's vector per
+// cycle, counted as P messages of its size / P). A CG iteration adds two
+// allreduces of one double (log2 P latencies each).
+#pragma once
+#include <vector>
+
+#include "kernels/grid.hpp"
+
+namespace tresca {
+
+struct CommVolume {
+  double messages = 0, bytes = 0;  // point-to-point, sent per rank
+  double allreduces = 0;           // of one double each
+  CommVolume& operator+=(const CommVolume& o) {
+    messages += o.messages;
+    bytes += o.bytes;
+    allreduces += o.allreduces;
+    return *this;
+  }
+  CommVolume operator*(double k) const { return {messages * k, bytes * k, allreduces * k}; }
+};
+
+struct NetworkModel {
+  double latency = 2e-6;    // alpha [s] per message (and per allreduce stage)
+  double bandwidth = 10e9;  // beta [B/s] per rank
+  // the time of v on P ranks: alpha (messages + allreduces log2 P) + bytes / beta
+  double seconds(const CommVolume& v, int ranks) const;
+};
+
+// one apply of K on an interior rank of px x py boxes of grid g
+CommVolume apply_halo(const GridDims& g, int px, int py);
+// the same for a slab rank (px = 1, py = ranks) that has `neighbours` (0..2)
+CommVolume slab_apply_halo(const GridDims& g, int neighbours);
+// one V-cycle over the hierarchy `grids` (finest first) with Chebyshev degree
+CommVolume vcycle_halo(const std::vector<GridDims>& grids, int px, int py, int degree, double agglomerate_nodes = 4096);
+// one MG-CG iteration: an apply, a V-cycle, two allreduces
+CommVolume mgcg_iteration(const std::vector<GridDims>& grids, int px, int py, int degree);
+
+// the most nearly square px x py = ranks with px / py close to nx / ny
+void rank_grid(const GridDims& g, int ranks, int& px, int& py);
+
+}  // namespace tresca

@@ -1,0 +1,82 @@
+// The matrix-free elasticity operator on a rank's slab (slab.hpp), with the
+// ghost rows exchanged by non-blocking point-to-point messages overlapped
+// with the interior rows of the apply:
+//
+//   1. pack the first and last owned rows, post MPI_Irecv / MPI_Isend to the
+//      neighbours below and above;
+//   2. apply K to the owned rows whose stencils do not reach a ghost row;
+//   3. wait, unpack the ghost rows, apply K to the (at most two) owned rows
+//      next to them.
+//
+// Vectors are local-box vectors (slab.hpp): y = K x on the owned rows and 0
+// on the ghost rows, so plain local dot products over the whole local
+// vector count every global entry once (CGOptions::comm sums them over the
+// ranks). The ghost rows of x are communication scratch: apply overwrites
+// them with the neighbours' values (x is const in the operator's interface,
+// as in CG, but its ghost entries belong to the exchange).
+//
+// Communication per apply and rank (the model, comm_model.hpp): one message
+// to and from each neighbour, 3 nx nz doubles each. With one rank nothing is
+// sent and the result is the whole-grid apply, bit for bit.
+#pragma once
+#include <vector>
+
+#include "core/parallel/comm.hpp"
+#include "core/parallel/slab.hpp"
+#include "core/solvers/operator.hpp"
+#include "kernels/elasticity.hpp"
+
+namespace tresca {
+
+struct HaloCounts {
+  long long exchanges = 0, messages = 0;  // messages sent by this rank
+  double bytes = 0;                      // bytes sent by this rank
+  double wait_seconds = 0;               // time blocked in MPI_Waitall
+};
+
+class DistributedElasticity : public LinearOperator {
+ public:
+  // faces: the global grid's constrained faces
+  DistributedElasticity(const Slab& s, unsigned faces, real E, real nu, const Comm& comm = Comm::world());
+  index size() const override { return 3 * slab_.local.nodes(); }
+  void apply(const real* x, real* y) const override;
+  // ghost rows of x := the neighbours' owned rows (blocking)
+  void exchange(real* x) const;
+  // diag(K) on the owned rows (1 on constrained dofs), 0 on the ghost rows
+  void diagonal(real* d) const;
+  // zero the ghost rows of a local vector
+  void zero_ghosts(real* v) const;
+  const Slab& slab() const { return slab_; }
+  const Comm& comm() const { return comm_; }
+  const HaloCounts& counts() const { return counts_; }
+  // overlap (default) or exchange first, then apply all rows: for measuring
+  void set_overlap(bool on) { overlap_ = on; }
+
+ private:
+  void begin_exchange(const real* x) const;
+  void end_exchange(real* x) const;
+  void apply_rows(const real* x, real* y, index y_begin, index y_end) const;
+
+  Slab slab_;
+  const Comm& comm_;
+  ElasticityStencil k_;
+  bool overlap_ = true;
+  mutable HaloCounts counts_;
+  mutable std::vector<real> send_lo_, send_hi_, recv_lo_, recv_hi_;
+  mutable std::vector<char> requests_;  // MPI_Request storage (opaque here)
+  mutable int pending_ = 0;
+};
+
+// z = D^{-1} r on the owned rows (Jacobi), 0 on the ghost rows: the CG
+// preconditioner of the distributed phase-1 solve
+class DistributedJacobi : public LinearOperator {
+ public:
+  explicit DistributedJacobi(const DistributedElasticity& K);
+  index size() const override { return index(inv_.size()); }
+  void apply(const real* r, real* z) const override;
+
+ private:
+  std::vector<real> inv_;
+};
+
+}  // namespace tresca

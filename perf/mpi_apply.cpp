@@ -1,0 +1,154 @@
+// mpi_apply: the distributed matrix-free apply and a distributed CG on
+// slabs of the grid (issue 12, phase 1), against the communication model.
+//
+//   mpirun --bind-to core -np 2 -x OMP_NUM_THREADS=1 build/bin/mpi_apply --level 11
+//   mpirun --bind-to none -np 1 -x OMP_NUM_THREADS=2 build/bin/mpi_apply --level 11
+//
+// Prints per rank count: M dof/s of y = K x (ghost exchange overlapped, and
+// exchange-then-apply), the halo messages and bytes per apply measured
+// against comm_model.hpp, the time blocked waiting for them, and a
+// Jacobi-preconditioned CG on K (u = 0 on x = 0 and on the contact face,
+// the seed load) to --rtol: iterations and time, the same on any rank count.
+// --project L,R: the model's weak-scaling projection of an MG-CG iteration
+// to R ranks at level L (assumed network: --latency, --bandwidth).
+#include <omp.h>
+
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "core/io/cli.hpp"
+#include "core/fem/problem.hpp"
+#include "core/parallel/comm.hpp"
+#include "core/parallel/comm_model.hpp"
+#include "core/parallel/distributed_elasticity.hpp"
+#include "core/solvers/cg.hpp"
+#include "core/solvers/multigrid.hpp"
+#include "core/util/profile.hpp"
+#include "kernels/simd.hpp"
+#include "kernels/vector_ops.hpp"
+
+using namespace tresca;
+
+static const char* kHelp =
+    "usage: mpi_apply [--level L | --dims EXxEYxEZ] [--reps N] [--rtol R] [--max-iterations N] [--threads N]\n"
+    "                 [--project LEVEL,RANKS] [--latency S] [--bandwidth B/s]\n"
+    "The distributed elasticity apply and a Jacobi-CG on y-slabs, one per MPI rank (default --level 8).\n"
+    "Run it with mpirun -np P; --project prints the communication model's projection instead.\n";
+
+namespace {
+
+int project(const Args& a) {
+  const std::string s = a.str("--project");
+  const auto sp = s.find(',');
+  if (sp == std::string::npos) throw std::invalid_argument("--project '" + s + "' must be LEVEL,RANKS");
+  const ProblemSpec spec = spec_for_level(std::stoll(s.substr(0, sp)));
+  const int ranks = int(std::stoll(s.substr(sp + 1)));
+  if (ranks < 1) throw std::invalid_argument("--project: ranks must be >= 1");
+  NetworkModel net;
+  net.latency = a.real_value("--latency", net.latency);
+  net.bandwidth = a.real_value("--bandwidth", net.bandwidth);
+  const GridDims g = grid_of(spec);
+  const auto H = GridHierarchy::build(g, MGOptions{}.coarse_nodes);
+  int px = 1, py = 1;
+  rank_grid(g, ranks, px, py);
+  const CommVolume ap = apply_halo(g, px, py), it = mgcg_iteration(H->grids, px, py, MGOptions{}.degree);
+  std::printf("level %d: mesh %s, %.3g dofs, %d ranks as %d x %d boxes, %.3g dofs per rank\n", spec.level,
+              dims_string(spec).c_str(), double(spec.free_dofs()), ranks, px, py, double(spec.free_dofs()) / ranks);
+  std::printf("network assumed: latency %.2g s, bandwidth %.3g GB/s per rank\n", net.latency, net.bandwidth / 1e9);
+  std::printf("apply:        %6.0f messages %10.4g bytes  -> %.3g s\n", ap.messages, ap.bytes, net.seconds(ap, ranks));
+  std::printf("MG-CG iter.:  %6.0f messages %10.4g bytes %3.0f allreduces -> %.3g s\n", it.messages, it.bytes,
+              it.allreduces, net.seconds(it, ranks));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  default_runtime_environment(argv);
+  MpiSession mpi(argc, argv);
+  const Comm& comm = Comm::world();
+  try {
+    Args a(argc, argv,
+           {"--level", "--dims", "--reps", "--rtol", "--max-iterations", "--threads", "--project", "--latency", "--bandwidth"},
+           {"--help"});
+    if (a.has("--help")) {
+      if (comm.rank() == 0) std::fputs(kHelp, stdout);
+      return 0;
+    }
+    const int threads = apply_threads(a);
+    if (a.has("--project")) return comm.rank() == 0 ? project(a) : 0;
+    const ProblemSpec spec = spec_from_args(a, 8);
+    const int reps = int(a.int_value("--reps", 20));
+    const real rtol = a.real_value("--rtol", 1e-6);
+    const int max_it = int(a.int_value("--max-iterations", 20000));
+    if (reps < 1) throw std::invalid_argument("--reps must be >= 1");
+    const GridDims g = grid_of(spec);
+    const Slab slab = make_slab(g, comm.rank(), comm.size());
+    const Problem P = make_problem(spec);  // every rank builds the global load (phase 1)
+    DistributedElasticity K(slab, P.interior_faces, spec.E, spec.nu, comm);
+    const tresca::index n = K.size();
+    std::vector<real> x(n), y(n);
+    for (tresca::index i = 0; i < n; ++i) x[i] = std::sin(0.001 * double(i + slab.y_begin));
+    if (comm.rank() == 0)
+      std::printf("mpi_apply: mesh %s (%s), %lld dofs, %d ranks x %d threads, y-slabs; kernels: %s\n",
+                  dims_string(spec).c_str(), spec.level >= 0 ? ("level " + std::to_string(spec.level)).c_str() : "dims",
+                  (long long)P.dofs(), comm.size(), threads, build_info().c_str());
+    const double dofs = double(P.dofs());
+    double rate[2];
+    HaloCounts before = K.counts();
+    for (int overlap = 1; overlap >= 0; --overlap) {
+      K.set_overlap(overlap);
+      K.apply(x.data(), y.data());  // warm-up
+      double best = 1e300;
+      for (int r = 0; r < reps; ++r) {
+        comm.barrier();
+        const double t0 = wall_time();
+        K.apply(x.data(), y.data());
+        best = std::min(best, comm.max(wall_time() - t0));
+      }
+      rate[overlap] = dofs / best;
+    }
+    const HaloCounts c = K.counts();
+    const double applies = double(c.exchanges - before.exchanges);
+    const CommVolume model = slab_apply_halo(g, int(slab.lo + slab.hi));
+    const double msg = applies > 0 ? (c.messages - before.messages) / applies : 0;
+    const double bytes = applies > 0 ? (c.bytes - before.bytes) / applies : 0;
+    const double wait = comm.max(c.wait_seconds) / std::max(1.0, applies);
+    if (comm.rank() == 0) {
+      std::printf("apply: %.1f M dof/s overlapped, %.1f M dof/s exchange-then-apply (best of %d, slowest rank)\n",
+                  rate[1] / 1e6, rate[0] / 1e6, reps);
+      std::printf("halo per apply (rank 0): %.0f messages, %.0f bytes; model %.0f, %.0f; wait %.3g ms per apply (max over ranks)\n",
+                  msg, bytes, model.messages, model.bytes, wait * 1e3);
+    }
+    // Jacobi-CG on the slab: the same iterations and answer on any rank count
+    K.set_overlap(true);
+    std::vector<real> b(n), u(n, 0.0);
+    global_to_local(slab, P.load.data(), b.data());
+    zero_constrained(slab.local, slab.local_faces(P.interior_faces), b.data());
+    K.zero_ghosts(b.data());
+    DistributedJacobi J(K);
+    CGOptions o;
+    o.rtol = rtol;
+    o.max_iterations = max_it;
+    o.comm = &comm;
+    CGWorkspace ws;
+    comm.barrier();
+    const double t0 = wall_time();
+    const SolveStats st = pcg(K, &J, b.data(), u.data(), o, ws);
+    const double t = comm.max(wall_time() - t0);
+    K.zero_ghosts(u.data());
+    const real unorm = std::sqrt(comm.sum(dot(n, u.data(), u.data())));
+    const double mem = comm.max(peak_memory_bytes());
+    if (comm.rank() == 0)
+      std::printf("Jacobi-CG to %.1e: %s after %d iterations, %.3f s (%.2f ms per iteration), |u| = %.12e; peak memory per rank %.3f GB\n",
+                  double(rtol), to_string(st.reason), st.iterations, t, 1e3 * t / std::max(1, st.iterations),
+                  double(unorm), mem / 1e9);
+    return st.ok() ? 0 : 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mpi_apply: %s\n", e.what());
+    return 2;
+  }
+}
