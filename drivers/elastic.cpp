@@ -20,6 +20,7 @@ static const char* kHelp =
 
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
+  require_one_rank("elastic");
   try {
     Args a(argc, argv, {"--level", "--dims", "--E", "--nu", "--rtol", "--threads"}, {"--help"});
     if (a.has("--help")) {

@@ -94,6 +94,7 @@ const PaperRow* paper_row(int level) {
 
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
+  require_one_rank("tresca");
   ProblemSpec spec;
   RunOptions opt;
   int threads = 1;

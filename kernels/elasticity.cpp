@@ -106,12 +106,17 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
 }  // namespace
 
 ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, real E, real nu) {
+  return build_elasticity_stencil(g, faces, E, nu, {g.hx(), g.hy(), g.hz()});
+}
+
+ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, real E, real nu,
+                                           const std::array<real, 3>& h) {
   ElasticityStencil k;
   k.g = g;
   k.faces = faces;
   k.E = E;
   k.nu = nu;
-  brick_stiffness(g.hx(), g.hy(), g.hz(), E, nu, k.Ke.data());
+  brick_stiffness(h[0], h[1], h[2], E, nu, k.Ke.data());
   const index n[3] = {g.nx(), g.ny(), g.nz()};
   const bool lo[3] = {bool(faces & kFaceX0), bool(faces & kFaceY0), bool(faces & kFaceZ0)};
   const bool hi[3] = {bool(faces & kFaceX1), bool(faces & kFaceY1), bool(faces & kFaceZ1)};

@@ -68,6 +68,10 @@ using StencilGroup = StencilGroupT<real>;
 
 // Builds Ke and all stencils needed by grid g with constrained faces.
 ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, real E, real nu);
+// ... with the bricks' edge lengths h given (a part of a larger grid, whose
+// own lengths ly/ey may round differently: core/parallel/slab.hpp)
+ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, real E, real nu,
+                                           const std::array<real, 3>& h);
 // The same stencils with coefficients rounded to T.
 template <class T>
 ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& k);

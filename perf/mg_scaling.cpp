@@ -14,6 +14,7 @@ using namespace tresca;
 
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
+  require_one_rank("mg_scaling");
   try {
     Args a(argc, argv, {"--levels", "--rtol", "--threads", "--json", "--precision"}, {"--help"});
     if (a.has("--help")) {

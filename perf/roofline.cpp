@@ -100,6 +100,7 @@ struct Row {
 
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
+  require_one_rank("roofline");
   try {
     Args a(argc, argv, {"--level", "--threads", "--reps", "--json"}, {"--help"});
     if (a.has("--help")) {

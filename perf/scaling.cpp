@@ -27,6 +27,7 @@ using namespace tresca;
 
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
+  require_one_rank("scaling");
   try {
     Args a(argc, argv, {"--levels", "--threads", "--phi", "--coulomb", "--coulomb-method", "--json"}, {"--help", "--no-nested"});
     if (a.has("--help")) {

@@ -1,5 +1,7 @@
 #include "core/io/cli.hpp"
 
+#include "core/parallel/comm.hpp"
+
 #include <utility>
 #include <omp.h>
 #include <unistd.h>
@@ -203,6 +205,20 @@ void default_runtime_environment(char** argv) {
       changed = true;
     }
   if (changed) execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
+}
+
+void require_one_rank(const char* program) {
+  const int ranks = launched_ranks();
+  if (ranks <= 1) return;
+  const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
+  if (!rank) rank = std::getenv("PMI_RANK");
+  if (!rank || std::string(rank) == "0")
+    std::fprintf(stderr,
+                 "%s: started as %d MPI ranks, but %s runs on one rank (its distributed version is issue 12's "
+                 "work in progress; build/bin/mpi_apply is distributed). Run it as one process, threads with "
+                 "OMP_NUM_THREADS or --threads.\n",
+                 program, ranks, program);
+  std::exit(2);
 }
 
 int apply_threads(const Args& a) {

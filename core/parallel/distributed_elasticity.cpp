@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "kernels/vector_ops.hpp"
+#include "kernels/vector_ops.hpp"  // worth_threads, kXpayCost (z = d r: the same streams)
 #include "core/util/profile.hpp"
 
 #ifdef TRESCA_HAVE_MPI
@@ -31,7 +31,7 @@ void fill_row(const GridDims& g, real value, index j, real* v) {
 }  // namespace
 
 DistributedElasticity::DistributedElasticity(const Slab& s, unsigned faces, real E, real nu, const Comm& comm)
-    : slab_(s), comm_(comm), k_(build_elasticity_stencil(s.local, s.local_faces(faces), E, nu)) {
+    : slab_(s), comm_(comm), k_(build_elasticity_stencil(s.local, s.local_faces(faces), E, nu, {s.global.hx(), s.global.hy(), s.global.hz()})) {
   const index row = 3 * s.local.nx() * s.local.nz();
   if (s.lo) send_lo_.resize(row), recv_lo_.resize(row);
   if (s.hi) send_hi_.resize(row), recv_hi_.resize(row);
@@ -127,7 +127,9 @@ DistributedJacobi::DistributedJacobi(const DistributedElasticity& K) : inv_(K.si
 
 void DistributedJacobi::apply(const real* r, real* z) const {
   const index n = size();
-  for (index i = 0; i < n; ++i) z[i] = inv_[i] * r[i];
+  const real* d = inv_.data();
+#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * kXpayCost))
+  for (index i = 0; i < n; ++i) z[i] = d[i] * r[i];
 }
 
 }  // namespace tresca

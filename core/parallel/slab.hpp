@@ -5,9 +5,11 @@
 // Rank r owns the global node rows [y_begin, y_end) (balanced: the first
 // ny % ranks ranks one row more) and keeps one ghost row on each side that
 // has a neighbour. Its vectors live on the local box of rows
-// [y_begin - lo, y_end + hi): a GridDims of its own, the same spacing, so
-// the elasticity kernels run on it unchanged; the owned rows of K x come
-// out bit for bit as on the whole grid (same per-node stencils).
+// [y_begin - lo, y_end + hi): a GridDims of its own with the same spacing
+// (ly/ey may round in the last bit, so operators on it take the global
+// grid's spacing), and the elasticity kernels run on it unchanged: the
+// owned rows of K x come out bit for bit as on the whole grid (the same
+// per-node stencils).
 //
 //   local row j = global row iy - (y_begin - lo);  owned: lo <= j < lo + owned_rows()
 #pragma once

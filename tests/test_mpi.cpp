@@ -1,0 +1,168 @@
+// The distributed pieces (core/parallel, issue 12 phase 1) held against the
+// whole-grid code on every rank. Run by CTest under mpirun with 2 and 3
+// ranks (mpi.*), and as one rank. Every rank builds the whole grid's
+// vectors too and compares its own slab with them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/fem/elasticity_operator.hpp"
+#include "core/parallel/comm.hpp"
+#include "core/parallel/comm_model.hpp"
+#include "core/parallel/distributed_elasticity.hpp"
+#include "core/solvers/cg.hpp"
+#include "kernels/vector_ops.hpp"
+#include "test_helpers.hpp"
+
+namespace tresca {
+namespace {
+
+const Comm& world() { return Comm::world(); }
+
+// K of the inner problem: clamped on x = 0 and the contact face z = 0
+constexpr unsigned kFaces = kFaceX0 | kFaceZ0;
+
+// the owned rows of a local vector against the same rows of a global one
+real max_owned_diff(const Slab& s, const std::vector<real>& local, const std::vector<real>& global) {
+  std::vector<real> mine(global);
+  local_to_global(s, local.data(), mine.data());
+  return test::max_abs_diff(mine, global);
+}
+
+}  // namespace
+
+TEST(Slab, RowsPartitionTheGridAndKeepTheSpacing) {
+  for (index ey : {1, 5, 16, 33})
+    for (int ranks = 1; ranks <= std::min<index>(7, ey + 1); ++ranks) {
+      const GridDims g = test::prism(6, ey, 3);
+      index next = 0;
+      for (int r = 0; r < ranks; ++r) {
+        const Slab s = make_slab(g, r, ranks);
+        EXPECT_EQ(s.y_begin, next);
+        EXPECT_GE(s.owned_rows(), 1);
+        next = s.y_end;
+        EXPECT_NEAR(s.local.hy(), g.hy(), 1e-15 * g.hy()) << "ey " << ey << " rank " << r << "/" << ranks;
+        EXPECT_EQ(s.local.ny(), s.owned_rows() + s.lo + s.hi);
+        EXPECT_NEAR(s.local.y0, g.y0 + g.hy() * real(s.y_begin - s.lo), 1e-14);
+        EXPECT_EQ(s.local.nx(), g.nx());
+        EXPECT_EQ(s.local.nz(), g.nz());
+      }
+      EXPECT_EQ(next, g.ny());
+    }
+  EXPECT_THROW(make_slab(test::prism(4, 2, 2), 0, 4), std::invalid_argument);
+}
+
+TEST(DistributedElasticity, OwnedRowsOfTheApplyEqualTheWholeGridsBitForBit) {
+  for (const GridDims& g : {test::prism(8, 8, 4), test::prism(7, 5, 3), test::prism(16, 12, 6)}) {
+    if (g.ny() < world().size()) continue;
+    const Slab s = make_slab(g, world().rank(), world().size());
+    const std::vector<real> xg = test::random_vector(3 * g.nodes(), 3);
+    std::vector<real> yg(xg.size());
+    ElasticityOperator(g, kFaces, 2.1e9, 0.277).apply(xg.data(), yg.data());
+    DistributedElasticity K(s, kFaces, 2.1e9, 0.277);
+    std::vector<real> x(K.size()), y(K.size(), 1.0);
+    global_to_local(s, xg.data(), x.data());
+    K.zero_ghosts(x.data());  // the ghosts must come from the exchange
+    for (bool overlap : {true, false}) {
+      K.set_overlap(overlap);
+      K.apply(x.data(), y.data());
+      EXPECT_EQ(max_owned_diff(s, y, yg), 0.0) << "overlap " << overlap << ", " << g.ex << "x" << g.ey << "x" << g.ez;
+      // the ghost rows of y are zero, so local dots count each entry once
+      std::vector<real> yy(y);
+      K.zero_ghosts(yy.data());
+      EXPECT_EQ(test::max_abs_diff(yy, y), 0.0);
+    }
+    const real local = dot(K.size(), y.data(), y.data());
+    EXPECT_NEAR(world().sum(local), dot(index(yg.size()), yg.data(), yg.data()), 1e-12 * dot(index(yg.size()), yg.data(), yg.data()));
+  }
+}
+
+TEST(DistributedElasticity, ExchangeFillsTheGhostRowsAndCountsAsTheModelSays) {
+  const GridDims g = test::prism(9, 10, 4);
+  if (g.ny() < world().size()) GTEST_SKIP();
+  const Slab s = make_slab(g, world().rank(), world().size());
+  const std::vector<real> xg = test::random_vector(3 * g.nodes(), 5);
+  DistributedElasticity K(s, kFaces, 1, 0.3);
+  std::vector<real> x(K.size()), expected(K.size());
+  global_to_local(s, xg.data(), expected.data());
+  x = expected;
+  K.zero_ghosts(x.data());
+  K.exchange(x.data());
+  EXPECT_EQ(test::max_abs_diff(x, expected), 0.0);
+  const CommVolume model = slab_apply_halo(g, int(s.lo + s.hi));
+  EXPECT_EQ(double(K.counts().messages), model.messages);
+  EXPECT_EQ(K.counts().bytes, model.bytes);
+  EXPECT_EQ(K.counts().exchanges, world().size() > 1 ? 1 : 0);
+  // an interior slab is a box decomposition 1 x P
+  if (s.lo && s.hi) EXPECT_EQ(apply_halo(g, 1, world().size()).bytes, model.bytes);
+}
+
+TEST(DistributedCG, SameIterationsAndSolutionAsTheWholeGrid) {
+  const GridDims g = test::prism(12, 10, 5);
+  if (g.ny() < world().size()) GTEST_SKIP();
+  const Slab s = make_slab(g, world().rank(), world().size());
+  // the whole grid: K, Jacobi, CG on one rank
+  const ElasticityOperator Kg(g, kFaces, 2.1e9, 0.277);
+  std::vector<real> bg = test::random_vector(3 * g.nodes(), 11);
+  zero_constrained(g, kFaces, bg.data());
+  const std::vector<real> dg = Kg.diagonal();
+  struct Jacobi : LinearOperator {
+    const std::vector<real>& d;
+    explicit Jacobi(const std::vector<real>& d_) : d(d_) {}
+    index size() const override { return index(d.size()); }
+    void apply(const real* r, real* z) const override {
+      for (size_t i = 0; i < d.size(); ++i) z[i] = r[i] / d[i];
+    }
+  } Mg(dg);
+  CGOptions o;
+  o.rtol = 1e-10;
+  o.max_iterations = 5000;
+  CGWorkspace ws;
+  std::vector<real> ug(bg.size());
+  const SolveStats sg = pcg(Kg, &Mg, bg.data(), ug.data(), o, ws);
+  ASSERT_TRUE(sg.ok());
+  // the slabs
+  DistributedElasticity K(s, kFaces, 2.1e9, 0.277);
+  DistributedJacobi M(K);
+  std::vector<real> b(K.size()), u(K.size());
+  global_to_local(s, bg.data(), b.data());
+  K.zero_ghosts(b.data());
+  o.comm = &world();
+  const SolveStats sd = pcg(K, &M, b.data(), u.data(), o, ws);
+  ASSERT_TRUE(sd.ok());
+  EXPECT_NEAR(sd.iterations, sg.iterations, 1);  // the ranks' partial sums round differently
+  EXPECT_LE(max_owned_diff(s, u, ug), 1e-9 * test::max_abs(ug));
+  if (world().size() == 1) EXPECT_EQ(sd.iterations, sg.iterations);
+}
+
+TEST(CommModel, BoxHalosAndTheRankGrid) {
+  const GridDims g = test::prism(64, 32, 32);
+  int px = 0, py = 0;
+  rank_grid(g, 1, px, py);
+  EXPECT_EQ(px * py, 1);
+  EXPECT_EQ(apply_halo(g, 1, 1).messages, 0);
+  rank_grid(g, 8, px, py);
+  EXPECT_EQ(px * py, 8);
+  EXPECT_EQ(px, 8);  // 65 x 33 x 33 nodes: 8 cuts of 33 x 33 nodes beat 4 x 2 boxes (2293 ghost nodes)
+  rank_grid(test::prism(64, 64, 32), 8, px, py);
+  EXPECT_EQ(px * py, 8);
+  EXPECT_TRUE(px == 2 || px == 4) << px;  // a square face: boxes beat slabs (3350 ghost nodes against 4290)
+  const CommVolume v = apply_halo(g, 4, 2);
+  EXPECT_EQ(v.messages, 8);
+  EXPECT_DOUBLE_EQ(v.bytes, 24.0 * 33 * (2 * 33.0 / 2 + 2 * 65.0 / 4 + 4));
+  NetworkModel net{1e-6, 1e9};
+  EXPECT_DOUBLE_EQ(net.seconds({10, 1e6, 2}, 8), 10e-6 + 2 * 3e-6 + 1e-3);
+}
+
+}  // namespace tresca
+
+int main(int argc, char** argv) {
+  tresca::MpiSession mpi(argc, argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  if (tresca::Comm::world().rank() != 0) {  // one report: rank 0's (a failure on any rank fails the run)
+    auto& listeners = ::testing::UnitTest::GetInstance()->listeners();
+    delete listeners.Release(listeners.default_result_printer());
+  }
+  return RUN_ALL_TESTS();
+}
