@@ -66,11 +66,20 @@ void DistributedElasticity::begin_exchange(const real* x) const {
 #endif
 }
 
+void DistributedElasticity::test_exchange() const {
+#ifdef TRESCA_HAVE_MPI
+  if (pending_ <= 0) return;
+  int done = 0;
+  MPI_Testall(pending_, reinterpret_cast<MPI_Request*>(requests_.data()), &done, MPI_STATUSES_IGNORE);
+  if (done) pending_ = -pending_;  // completed: nothing left to wait for (unpack still due)
+#endif
+}
+
 void DistributedElasticity::end_exchange(real* x) const {
   if (!slab_.lo && !slab_.hi) return;
 #ifdef TRESCA_HAVE_MPI
   const double t0 = wall_time();
-  MPI_Waitall(pending_, reinterpret_cast<MPI_Request*>(requests_.data()), MPI_STATUSES_IGNORE);
+  if (pending_ > 0) MPI_Waitall(pending_, reinterpret_cast<MPI_Request*>(requests_.data()), MPI_STATUSES_IGNORE);
   counts_.wait_seconds += wall_time() - t0;
   pending_ = 0;
   const GridDims& g = slab_.local;
@@ -98,8 +107,15 @@ void DistributedElasticity::apply(const real* x, real* y) const {
   const index first = slab_.lo, last = slab_.lo + slab_.owned_rows();  // owned local rows [first, last)
   if (overlap_) {
     begin_exchange(x);
-    // rows whose stencils stay inside the owned rows
-    apply_rows(x, y, first + slab_.lo, std::max(first + slab_.lo, last - slab_.hi));
+    // rows whose stencils stay inside the owned rows, in chunks with a test
+    // of the messages between them: Open MPI moves a large (rendezvous)
+    // message only while the rank is inside an MPI call
+    const index r0 = first + slab_.lo, r1 = std::max(r0, last - slab_.hi);
+    const index chunks = slab_.lo + slab_.hi == 0 ? 1 : std::min<index>(kProgressChunks, std::max<index>(1, r1 - r0));
+    for (index c = 0; c < chunks; ++c) {
+      apply_rows(x, y, r0 + (r1 - r0) * c / chunks, r0 + (r1 - r0) * (c + 1) / chunks);
+      if (c + 1 < chunks) test_exchange();
+    }
     end_exchange(xg);
     if (slab_.lo) apply_rows(x, y, first, std::min(first + 1, last));
     if (slab_.hi && last - 1 >= first + slab_.lo) apply_rows(x, y, last - 1, last);

@@ -4,7 +4,8 @@
 //
 //   1. pack the first and last owned rows, post MPI_Irecv / MPI_Isend to the
 //      neighbours below and above;
-//   2. apply K to the owned rows whose stencils do not reach a ghost row;
+//   2. apply K to the owned rows whose stencils do not reach a ghost row,
+//      in chunks with MPI_Testall between them (progress of large messages);
 //   3. wait, unpack the ghost rows, apply K to the (at most two) owned rows
 //      next to them.
 //
@@ -55,6 +56,8 @@ class DistributedElasticity : public LinearOperator {
  private:
   void begin_exchange(const real* x) const;
   void end_exchange(real* x) const;
+  void test_exchange() const;  // lets MPI progress the messages (MPI_Testall)
+  static constexpr index kProgressChunks = 8;
   void apply_rows(const real* x, real* y, index y_begin, index y_end) const;
 
   Slab slab_;
@@ -64,7 +67,7 @@ class DistributedElasticity : public LinearOperator {
   mutable HaloCounts counts_;
   mutable std::vector<real> send_lo_, send_hi_, recv_lo_, recv_hi_;
   mutable std::vector<char> requests_;  // MPI_Request storage (opaque here)
-  mutable int pending_ = 0;
+  mutable int pending_ = 0;  // requests in flight; negative: all completed by a test
 };
 
 // z = D^{-1} r on the owned rows (Jacobi), 0 on the ghost rows: the CG
