@@ -1,5 +1,7 @@
 #include "transfer.hpp"
 
+#include <algorithm>
+
 namespace tresca {
 namespace {
 
@@ -45,6 +47,38 @@ Transfer build_transfer(const GridDims& fine, const GridDims& coarse) {
   t.axis[1] = build_axis(fine.ey, coarse.ey);
   t.axis[2] = build_axis(fine.ez, coarse.ez);
   return t;
+}
+
+Transfer slice_rows(const Transfer& t, index f0, index f1, index c0, index c1) {
+  TRESCA_ASSERT(0 <= f0 && f0 + 2 <= f1 && f1 <= t.fine.ny() && 0 <= c0 && c0 + 2 <= c1 && c1 <= t.coarse.ny());
+  Transfer s = t;
+  auto box = [](const GridDims& g, index a, index b) {
+    GridDims r = g;
+    r.ey = b - a - 1;
+    r.y0 = g.y0 + real(a) * g.hy();
+    r.ly = g.hy() * real(r.ey);
+    return r;
+  };
+  s.fine = box(t.fine, f0, f1);
+  s.coarse = box(t.coarse, c0, c1);
+  const Interp1D& Y = t.axis[1];
+  Interp1D y;
+  for (index i = f0; i < f1; ++i) {
+    // rows outside [c0, c1) are clamped in (their values are partial anyway)
+    y.j0.push_back(std::clamp(Y.j0[i] - c0, index(0), c1 - c0 - 2));
+    y.w.push_back(Y.w[i]);
+  }
+  y.tstart.push_back(0);
+  for (index j = c0; j < c1; ++j) {
+    for (index k = Y.tstart[j]; k < Y.tstart[j + 1]; ++k)
+      if (Y.tf[k] >= f0 && Y.tf[k] < f1) {
+        y.tf.push_back(Y.tf[k] - f0);
+        y.tw.push_back(Y.tw[k]);
+      }
+    y.tstart.push_back(index(y.tf.size()));
+  }
+  s.axis[1] = std::move(y);
+  return s;
 }
 
 template <class T>

@@ -46,6 +46,13 @@ struct Transfer {
 
 Transfer build_transfer(const GridDims& fine, const GridDims& coarse);
 
+// The part of t between fine rows [f0, f1) and coarse rows [c0, c1) (y
+// only), each as a box of its own: prolongation onto a fine row is exact
+// where its two coarse rows lie in [c0, c1), restriction onto a coarse row
+// where its fine rows lie in [f0, f1); other rows get partial values (a
+// rank's ghost rows, core/parallel). Box dims are t's with ey = rows - 1.
+Transfer slice_rows(const Transfer& t, index f0, index f1, index c0, index c1);
+
 // fine = P coarse (or fine += P coarse with accumulate), for `comps` components.
 // The optimised kernels are instantiated for T = double and float.
 template <class T>

@@ -1,0 +1,278 @@
+#include "core/parallel/distributed_multigrid.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "kernels/transfer.hpp"
+#include "kernels/vector_ops.hpp"
+#include "core/util/profile.hpp"
+
+namespace tresca {
+
+// One level: distributed (slab, A with ghost exchange) or replicated (the
+// whole grid's operator on every rank).
+struct DistributedMultigrid::Level {
+  GridDims g;
+  bool distributed = false;
+  Slab slab;                                  // distributed: this rank's; replicated: the whole grid
+  std::unique_ptr<DistributedElasticity> Ad;  // distributed
+  ElasticityOperator Ar;                      // replicated
+  std::vector<real> dinv;
+  mutable std::vector<real> x, b, r, d;
+  mutable real* xp = nullptr;        // iterate and right-hand side in use (the caller's on level 0)
+  mutable const real* bp = nullptr;
+  real lmax = 0;
+  index n = 0;  // local vector size
+  // to the next coarser level
+  std::unique_ptr<RowFetch> fetch_fine;    // the fine rows (of r here) the coarse rows restrict from
+  std::unique_ptr<RowFetch> fetch_coarse;  // the coarse rows (of x there) this level interpolates from
+  Transfer restrict_t, prolong_t;
+  mutable std::vector<real> fine_rows, coarse_rows;
+  const LinearOperator& A() const { return distributed ? static_cast<const LinearOperator&>(*Ad) : Ar; }
+};
+
+namespace {
+
+// deterministic value in [-0.5, 0.5] of a global dof index (splitmix64)
+real hashed(std::uint64_t i) {
+  std::uint64_t z = i + 0x9E3779B97F4A7C15ULL;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  z ^= z >> 31;
+  return real(z >> 11) / real(1ULL << 53) - 0.5;
+}
+
+// local rows [first, last) of slab s as global rows
+void row_range(const Slab& s, index& first, index& last) {
+  first = s.y_begin - s.lo;
+  last = s.y_end + s.hi;
+}
+
+}  // namespace
+
+DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt,
+                                           const Comm& comm, index min_nodes_per_rank)
+    : opt_(opt), comm_(comm), faces_(faces), grids_(GridHierarchy::build(fine, opt.coarse_nodes)) {
+  const int P = comm.size();
+  bool replicated = P == 1;
+  for (const GridDims& g : grids_->grids) {
+    auto lv = std::make_unique<Level>();
+    lv->g = g;
+    const bool coarsest = levels_.size() + 1 == grids_->grids.size();  // solved by a factorisation on each rank
+    replicated = replicated || coarsest || g.ny() < 2 * P || g.nodes() / P < min_nodes_per_rank;
+    lv->distributed = !replicated;
+    if (lv->distributed) {
+      lv->slab = make_slab(g, comm.rank(), P);
+      lv->Ad = std::make_unique<DistributedElasticity>(lv->slab, faces, E, nu, comm);
+      lv->n = lv->Ad->size();
+      lv->dinv.resize(lv->n);
+      lv->Ad->diagonal(lv->dinv.data());
+    } else {
+      lv->slab = make_slab(g, 0, 1);
+      lv->Ar = ElasticityOperator(g, faces, E, nu);
+      lv->n = lv->Ar.size();
+      lv->dinv = lv->Ar.diagonal();
+    }
+    for (real& v : lv->dinv) v = v != 0 ? 1 / v : 0;  // ghost rows: 0
+    lv->x.resize(lv->n);
+    lv->b.resize(lv->n);
+    lv->r.resize(lv->n);
+    lv->d.resize(lv->n);
+    lv->xp = lv->x.data();
+    lv->bp = lv->b.data();
+    levels_.push_back(std::move(lv));
+  }
+  // transfers
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) {
+    Level &f = *levels_[l], &c = *levels_[l + 1];
+    const Transfer& T = grids_->to_coarse[l];
+    const Interp1D& Y = T.axis[1];
+    index f0, f1, c0, c1;
+    row_range(f.slab, f0, f1);
+    row_range(c.slab, c0, c1);
+    if (!f.distributed) {  // both replicated
+      f.restrict_t = f.prolong_t = T;
+      continue;
+    }
+    // restriction onto the coarse local rows [c0, c1): the fine rows of their lists
+    index a = f.g.ny(), b = 0;
+    for (index j = c0; j < c1; ++j)
+      for (index k = Y.tstart[j]; k < Y.tstart[j + 1]; ++k) a = std::min(a, Y.tf[k]), b = std::max(b, Y.tf[k] + 1);
+    if (b - a < 2) b = std::min(f.g.ny(), a + 2), a = b - 2;
+    f.fetch_fine = std::make_unique<RowFetch>(f.slab, a, b, comm);
+    f.fine_rows.resize(3 * f.fetch_fine->box().nodes());
+    f.restrict_t = slice_rows(T, a, b, c0, c1);
+    // prolongation onto the fine local rows [f0, f1): the coarse rows they interpolate from
+    index ca = c.g.ny(), cb = 0;
+    for (index i = f0; i < f1; ++i) ca = std::min(ca, Y.j0[i]), cb = std::max(cb, Y.j0[i] + 2);
+    cb = std::min(cb, c.g.ny());
+    if (cb - ca < 2) ca = cb - 2;
+    if (c.distributed) {
+      f.fetch_coarse = std::make_unique<RowFetch>(c.slab, ca, cb, comm);
+      f.coarse_rows.resize(3 * f.fetch_coarse->box().nodes());
+      f.prolong_t = slice_rows(T, f0, f1, ca, cb);
+    } else {
+      f.prolong_t = slice_rows(T, f0, f1, 0, c.g.ny());  // the coarse vector is whole here
+    }
+  }
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) estimate_lmax(*levels_[l]);
+  SparseMatrix A = assemble(levels_.back()->Ar);
+  coarse_.compute(A);
+  if (coarse_.info() != Eigen::Success) throw std::runtime_error("distributed multigrid: coarse factorisation failed");
+  cb_.resize(A.rows());
+  cx_.resize(A.rows());
+}
+
+DistributedMultigrid::~DistributedMultigrid() = default;
+
+index DistributedMultigrid::size() const { return levels_[0]->n; }
+const LinearOperator& DistributedMultigrid::op() const { return levels_[0]->A(); }
+bool DistributedMultigrid::fine_distributed() const { return levels_[0]->distributed; }
+const Slab& DistributedMultigrid::fine_slab() const { return levels_[0]->slab; }
+real DistributedMultigrid::lmax(int level) const { return levels_[level]->lmax; }
+int DistributedMultigrid::distributed_levels() const {
+  int k = 0;
+  for (const auto& lv : levels_) k += lv->distributed ? 1 : 0;
+  return k;
+}
+
+void DistributedMultigrid::estimate_lmax(Level& lv) {
+  // Lanczos through Jacobi-PCG as in multigrid.cpp; start vector hashed from
+  // the global dof index, dot products over all ranks if distributed
+  const index n = lv.n;
+  const Comm* comm = lv.distributed ? &comm_ : nullptr;
+  auto global = [&](real s) { return comm ? comm->sum(s) : s; };
+  std::vector<real> x(n, 0), r(n), z(n), p(n), q(n);
+  const GridDims& box = lv.slab.local;
+  const index N = box.nodes(), G = lv.g.nodes(), row0 = lv.slab.y_begin - lv.slab.lo;
+  for (int c = 0; c < 3; ++c)
+    for (index iz = 0; iz < box.nz(); ++iz)
+      for (index j = 0; j < box.ny(); ++j)
+        for (index ix = 0; ix < box.nx(); ++ix)
+          r[c * N + box.node(ix, j, iz)] = hashed(std::uint64_t(c * G + lv.g.node(ix, row0 + j, iz)));
+  zero_constrained(box, lv.slab.local_faces(faces_), r.data());
+  if (lv.distributed) lv.Ad->zero_ghosts(r.data());
+  hadamard(n, lv.dinv.data(), r.data(), z.data());
+  copy(n, z.data(), p.data());
+  real rz = global(dot(n, r.data(), z.data()));
+  std::vector<real> al, be;
+  for (int j = 0; j < 15 && rz > 0; ++j) {
+    lv.A().apply(p.data(), q.data());
+    const real a = rz / global(dot(n, p.data(), q.data()));
+    cg_update(n, a, p.data(), q.data(), x.data(), r.data());
+    hadamard(n, lv.dinv.data(), r.data(), z.data());
+    const real rz_new = global(dot(n, r.data(), z.data()));
+    al.push_back(a);
+    be.push_back(rz_new / rz);
+    xpay(n, z.data(), rz_new / rz, p.data());
+    rz = rz_new;
+  }
+  const int m = int(al.size());
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(m, m);
+  for (int j = 0; j < m; ++j) {
+    T(j, j) = 1 / al[j] + (j > 0 ? be[j - 1] / al[j - 1] : 0);
+    if (j + 1 < m) T(j, j + 1) = T(j + 1, j) = std::sqrt(be[j]) / al[j];
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T, Eigen::EigenvaluesOnly);
+  lv.lmax = 1.15 * std::max(es.eigenvalues().maxCoeff(), real(2));
+}
+
+void DistributedMultigrid::residual(const Level& lv, const real* b, const real* x, real* r) const {
+  if (!lv.distributed) {
+    lv.Ar.residual(b, x, r);
+    return;
+  }
+  lv.Ad->apply(x, r);  // ghost rows of r: 0, as b's
+  const index n = lv.n;
+#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * kXpayCost))
+  for (index i = 0; i < n; ++i) r[i] = b[i] - r[i];
+}
+
+void DistributedMultigrid::smooth(int l, bool zero_guess) const {
+  const Level& lv = *levels_[l];
+  const index n = lv.n;
+  ScopedTimer t(Kernel::smoother);
+  const real lmax = lv.lmax, lmin = lmax / opt_.range;
+  const real theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
+  real *x = lv.xp, *r = lv.r.data(), *d = lv.d.data();
+  if (zero_guess) {
+    cheb_first<real>(n, 1 / theta, lv.dinv.data(), lv.bp, d, x);
+  } else {
+    residual(lv, lv.bp, x, r);
+    fill<real>(n, 0, d);
+    cheb_update<real>(n, 0, 1 / theta, lv.dinv.data(), r, d, x);
+  }
+  real rho = 1 / sigma;
+  for (int k = 1; k < opt_.degree; ++k) {
+    residual(lv, lv.bp, x, r);
+    const real rho_new = 1 / (2 * sigma - rho);
+    cheb_update<real>(n, rho_new * rho, 2 * rho_new / delta, lv.dinv.data(), r, d, x);
+    rho = rho_new;
+  }
+}
+
+void DistributedMultigrid::vcycle(int l) const {
+  const Level& lv = *levels_[l];
+  if (l + 1 == int(levels_.size())) {
+    ScopedTimer t(Kernel::coarse_solve);
+    for (index i = 0; i < lv.n; ++i) cb_[i] = lv.bp[i];
+    cx_ = coarse_.solve(cb_);
+    for (index i = 0; i < lv.n; ++i) lv.xp[i] = cx_[i];
+    return;
+  }
+  const Level& c = *levels_[l + 1];
+  smooth(l, true);
+  residual(lv, lv.bp, lv.xp, lv.r.data());
+  {
+    ScopedTimer t(Kernel::restrict_, double(lv.n) * kRestrictCost);
+    const real* fine = lv.r.data();
+    if (lv.fetch_fine) {
+      lv.fetch_fine->fetch(lv.r.data(), lv.fine_rows.data());
+      fine = lv.fine_rows.data();
+    }
+    restrict_to_coarse<real>(lv.restrict_t, 3, fine, c.b.data());
+    zero_constrained<real>(c.slab.local, c.slab.local_faces(faces_), c.b.data());
+    if (c.distributed) c.Ad->zero_ghosts(c.b.data());
+  }
+  vcycle(l + 1);
+  {
+    ScopedTimer t(Kernel::prolongate, double(lv.n) * kProlongateCost);
+    const real* coarse = c.x.data();
+    if (lv.fetch_coarse) {
+      lv.fetch_coarse->fetch(c.x.data(), lv.coarse_rows.data());
+      coarse = lv.coarse_rows.data();
+    }
+    prolongate<real>(lv.prolong_t, 3, coarse, lv.xp, true);
+    zero_constrained<real>(lv.slab.local, lv.slab.local_faces(faces_), lv.xp);
+  }
+  smooth(l, false);
+}
+
+void DistributedMultigrid::apply(const real* r, real* z) const {
+  Level& f = *levels_[0];
+  f.bp = r;
+  f.xp = z;
+  vcycle(0);
+  if (f.distributed) f.Ad->zero_ghosts(z);
+  f.bp = f.b.data();
+  f.xp = f.x.data();
+}
+
+double DistributedMultigrid::cycle_work() const {
+  double w = 0;
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) w += double(levels_[l]->g.nodes());
+  return 2.0 * opt_.degree * w / double(levels_[0]->g.nodes());
+}
+
+std::string DistributedMultigrid::describe() const {
+  std::ostringstream os;
+  os << levels_.size() << " levels:";
+  for (const auto& lv : levels_) os << " " << lv->g.ex << "x" << lv->g.ey << "x" << lv->g.ez << (lv->distributed ? "(d)" : "");
+  os << " (double precision; (d): distributed over " << comm_.size() << " ranks, others replicated)";
+  return os.str();
+}
+
+}  // namespace tresca

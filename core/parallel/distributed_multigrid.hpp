@@ -1,0 +1,72 @@
+// The geometric-multigrid V-cycle of multigrid.hpp on y-slabs (issue 12,
+// phase 2): the same hierarchy (GridHierarchy::build), smoother (Chebyshev
+// of degree d in D^{-1} A, bounds from a Lanczos estimate), transfers
+// (trilinear, non-nested) and coarsest solve (Eigen LDLT), in double
+// precision, with the work split over the ranks:
+//
+// * fine levels are distributed: each rank holds its slab of the level
+//   (make_slab of that level's grid) and applies A with ghost exchange
+//   (distributed_elasticity.hpp);
+// * a level with fewer than 2 node rows per rank or fewer than
+//   `min_nodes_per_rank` nodes per rank, and every coarser one, is
+//   replicated: every rank holds all of it and computes the same thing
+//   (agglomeration onto all ranks, no messages inside; the coarsest is
+//   solved by each rank's own factorisation);
+// * transfers between distributed levels fetch the rows that neighbours
+//   own (row_fetch.hpp): the coarse rows a fine slab interpolates from, the
+//   fine rows a coarse slab restricts from; at the first replicated level
+//   the fine residual is gathered whole.
+//
+// One rank: every level replicated, i.e. multigrid.hpp's V-cycle in double
+// precision (up to the Lanczos start vector, here a hash of the global
+// index so that it does not depend on the rank count).
+#pragma once
+#include <Eigen/SparseCholesky>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/fem/assembly.hpp"
+#include "core/fem/elasticity_operator.hpp"
+#include "core/parallel/distributed_elasticity.hpp"
+#include "core/parallel/row_fetch.hpp"
+#include "core/solvers/multigrid.hpp"
+
+namespace tresca {
+
+class DistributedMultigrid : public LinearOperator {
+ public:
+  DistributedMultigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt = {},
+                       const Comm& comm = Comm::world(), index min_nodes_per_rank = 2048);
+  ~DistributedMultigrid() override;
+  // on level-0 local vectors: the slab's local box if level 0 is
+  // distributed, the whole grid if not (one rank)
+  index size() const override;
+  void apply(const real* r, real* z) const override;
+  // the fine operator on the same vectors (zero ghost rows on output)
+  const LinearOperator& op() const;
+  bool fine_distributed() const;
+  const Slab& fine_slab() const;  // level 0's slab (the whole grid when replicated)
+  int num_levels() const { return int(levels_.size()); }
+  int distributed_levels() const;
+  double cycle_work() const;  // as Multigrid::cycle_work
+  real lmax(int level) const;
+  std::string describe() const;
+
+ private:
+  struct Level;
+  void estimate_lmax(Level& lv);
+  void residual(const Level& lv, const real* b, const real* x, real* r) const;
+  void smooth(int l, bool zero_guess) const;
+  void vcycle(int l) const;
+
+  MGOptions opt_;
+  const Comm& comm_;
+  unsigned faces_;
+  std::shared_ptr<const GridHierarchy> grids_;
+  std::vector<std::unique_ptr<Level>> levels_;
+  Eigen::SimplicialLDLT<SparseMatrix> coarse_;
+  mutable Eigen::VectorXd cb_, cx_;
+};
+
+}  // namespace tresca

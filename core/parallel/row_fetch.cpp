@@ -1,0 +1,89 @@
+#include "core/parallel/row_fetch.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#ifdef TRESCA_HAVE_MPI
+#include <mpi.h>
+#endif
+
+namespace tresca {
+
+GridDims row_box(const GridDims& g, index a, index b) {
+  GridDims box = g;
+  box.ey = b - a - 1;
+  box.y0 = g.y0 + real(a) * g.hy();
+  box.ly = g.hy() * real(box.ey);
+  return box;
+}
+
+namespace {
+// rows [r0, r1) of all planes and components: from grid ga at row ra to grid gb at row rb, or packed
+void rows_to_buffer(const GridDims& g, const real* v, index r0, index r1, real* buf) {
+  const index nx = g.nx(), N = g.nodes(), len = (r1 - r0) * nx;
+  for (int c = 0; c < 3; ++c)
+    for (index iz = 0; iz < g.nz(); ++iz, buf += len) std::copy_n(v + c * N + g.node(0, r0, iz), len, buf);
+}
+void buffer_to_rows(const GridDims& g, const real* buf, index r0, index r1, real* v) {
+  const index nx = g.nx(), N = g.nodes(), len = (r1 - r0) * nx;
+  for (int c = 0; c < 3; ++c)
+    for (index iz = 0; iz < g.nz(); ++iz, buf += len) std::copy_n(buf, len, v + c * N + g.node(0, r0, iz));
+}
+}  // namespace
+
+RowFetch::RowFetch(const Slab& s, index a, index b, const Comm& comm) : s_(s), comm_(comm), a_(a), b_(b) {
+  if (!(0 <= a && a < b && b <= s.global.ny()) || b - a < 2)
+    throw std::invalid_argument("RowFetch: rows [" + std::to_string(a) + ", " + std::to_string(b) + ") of " +
+                                std::to_string(s.global.ny()));
+  box_ = row_box(s.global, a, b);
+  const int P = comm.size();
+  std::vector<long long> mine = {(long long)a, (long long)b, (long long)s.y_begin, (long long)s.y_end};
+  std::vector<long long> all(4 * size_t(P));
+#ifdef TRESCA_HAVE_MPI
+  if (P > 1)
+    MPI_Allgather(mine.data(), 4, MPI_LONG_LONG, all.data(), 4, MPI_LONG_LONG, MPI_COMM_WORLD);
+  else
+#endif
+    all = mine;
+  const index plane_row = 3 * s.global.nx() * s.global.nz();  // doubles per row
+  send_lo_.resize(P), send_hi_.resize(P), recv_lo_.resize(P), recv_hi_.resize(P);
+  send_counts_.assign(P, 0), send_displs_.assign(P, 0), recv_counts_.assign(P, 0), recv_displs_.assign(P, 0);
+  int so = 0, ro = 0;
+  for (int q = 0; q < P; ++q) {
+    // q wants [all[4q], all[4q+1]); I own [y_begin, y_end)
+    send_lo_[q] = std::max<index>(index(all[4 * q]), s.y_begin);
+    send_hi_[q] = std::max(send_lo_[q], std::min<index>(index(all[4 * q + 1]), s.y_end));
+    // I want [a, b); q owns [all[4q+2], all[4q+3])
+    recv_lo_[q] = std::max<index>(a, index(all[4 * q + 2]));
+    recv_hi_[q] = std::max(recv_lo_[q], std::min<index>(b, index(all[4 * q + 3])));
+    send_counts_[q] = int((send_hi_[q] - send_lo_[q]) * plane_row);
+    recv_counts_[q] = int((recv_hi_[q] - recv_lo_[q]) * plane_row);
+    send_displs_[q] = so;
+    recv_displs_[q] = ro;
+    so += send_counts_[q];
+    ro += recv_counts_[q];
+    if (q != comm.rank()) bytes_ += double(send_counts_[q]) * sizeof(real);
+  }
+  if (ro != int((b - a) * plane_row)) throw std::logic_error("RowFetch: the owners do not cover the rows");
+  send_.resize(so);
+  recv_.resize(ro);
+}
+
+void RowFetch::fetch(const real* local, real* out) const {
+  const int P = comm_.size();
+  for (int q = 0; q < P; ++q)
+    if (send_counts_[q])
+      rows_to_buffer(s_.local, local, s_.local_row(send_lo_[q]), s_.local_row(send_hi_[q]), send_.data() + send_displs_[q]);
+#ifdef TRESCA_HAVE_MPI
+  if (P > 1)
+    MPI_Alltoallv(send_.data(), send_counts_.data(), send_displs_.data(), MPI_DOUBLE, recv_.data(), recv_counts_.data(),
+                  recv_displs_.data(), MPI_DOUBLE, MPI_COMM_WORLD);
+  else
+#endif
+    std::copy(send_.begin(), send_.end(), recv_.begin());
+  for (int q = 0; q < P; ++q)
+    if (recv_counts_[q]) buffer_to_rows(box_, recv_.data() + recv_displs_[q], recv_lo_[q] - a_, recv_hi_[q] - a_, out);
+}
+
+}  // namespace tresca

@@ -1,0 +1,46 @@
+// Fetching a range of node rows of a y-slab-distributed vector (slab.hpp)
+// onto one rank: the multigrid transfers between non-nested levels need
+// rows that neighbouring ranks own (the coarse rows a fine slab
+// interpolates from, the fine rows a coarse slab restricts from), and the
+// first replicated coarse level needs all of them.
+//
+// Each rank asks for one contiguous range [a, b) of the global rows; the
+// ranges are exchanged once (MPI_Allgather) when the fetch is set up, and
+// every fetch is one MPI_Alltoallv of the intersections with the owners'
+// rows (3 components, all planes). One rank: a copy.
+#pragma once
+#include <vector>
+
+#include "core/parallel/comm.hpp"
+#include "core/parallel/slab.hpp"
+
+namespace tresca {
+
+class RowFetch {
+ public:
+  // s: this rank's slab of the distributed vector; rows [a, b) wanted here
+  RowFetch(const Slab& s, index a, index b, const Comm& comm = Comm::world());
+  // the box of the fetched rows: the global grid's x and z, rows [a, b)
+  const GridDims& box() const { return box_; }
+  index first_row() const { return a_; }
+  // out (3 * box().nodes()) := rows [a, b) of the distributed vector whose
+  // local part (slab's local box) is `local`
+  void fetch(const real* local, real* out) const;
+  double bytes_per_fetch() const { return bytes_; }
+
+ private:
+  Slab s_;
+  const Comm& comm_;
+  index a_, b_;
+  GridDims box_;
+  // per rank q: rows [send_lo, send_hi) of mine go to q, rows [recv_lo, recv_hi) of my box come from q
+  std::vector<index> send_lo_, send_hi_, recv_lo_, recv_hi_;
+  std::vector<int> send_counts_, send_displs_, recv_counts_, recv_displs_;
+  mutable std::vector<real> send_, recv_;
+  double bytes_ = 0;
+};
+
+// the rows [a, b) of g as a box of their own (spacing up to rounding, slab.hpp)
+GridDims row_box(const GridDims& g, index a, index b);
+
+}  // namespace tresca
