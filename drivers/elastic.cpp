@@ -2,7 +2,7 @@
 // and on the contact face) with multigrid-preconditioned CG and print a
 // summary. The smallest end-to-end check of mesh, kernels and inner solver.
 // Under mpirun with several ranks the grid is split into y-slabs and the
-// V-cycle is core/parallel/distributed_multigrid.hpp's (double precision);
+// V-cycle is core/parallel/distributed_multigrid.hpp's;
 // one rank is the threaded solver of core/fem/interior.hpp.
 #include <cstdio>
 #include <exception>
@@ -30,9 +30,7 @@ int run_distributed(const ProblemSpec& spec, real rtol, int threads, const Comm&
   const bool root = comm.rank() == 0;
   const double t0 = wall_time();
   const Problem P = make_problem(spec);  // every rank builds the whole load (phase 2)
-  MGOptions mo;
-  mo.precision = Precision::double_precision;
-  const DistributedMultigrid mg(P.grid, P.interior_faces, spec.E, spec.nu, mo, comm);
+  const DistributedMultigrid mg(P.grid, P.interior_faces, spec.E, spec.nu, MGOptions{}, comm);
   const Slab& s = mg.fine_slab();
   const tresca::index n = mg.size();
   std::vector<real> b(n), u(n), r(n);

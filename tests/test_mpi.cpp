@@ -167,9 +167,10 @@ TEST(RowFetch, AnyRangeOfRowsFromTheirOwners) {
 // partial sums) and solution; fine levels distributed (64 nodes per rank
 // suffice here, so two levels are split and the third replicated)
 TEST(DistributedMultigrid, CGMatchesTheWholeGridMultigrid) {
-  for (const GridDims& g : {test::prism(32, 24, 16), test::prism(27, 19, 11)}) {
+  for (const GridDims& g : {test::prism(32, 24, 16), test::prism(27, 19, 11)})
+  for (Precision prec : {Precision::double_precision, Precision::single_precision}) {
     MGOptions mo;
-    mo.precision = Precision::double_precision;
+    mo.precision = prec;
     const Multigrid mg(g, kFaces, 2.1e9, 0.277, mo);
     const DistributedMultigrid dmg(g, kFaces, 2.1e9, 0.277, mo, world(), 64);
     ASSERT_EQ(dmg.num_levels(), mg.num_levels());

@@ -1,6 +1,7 @@
 #include "core/parallel/distributed_elasticity.hpp"
 
 #include <algorithm>
+#include <type_traits>
 
 #include "kernels/vector_ops.hpp"  // worth_threads, kXpayCost (z = d r: the same streams)
 #include "core/util/profile.hpp"
@@ -13,54 +14,78 @@ namespace tresca {
 
 namespace {
 // the ghost or boundary row j of all planes and components <-> a packed buffer
-void pack_row(const GridDims& g, const real* v, index j, real* buf) {
+template <class T>
+void pack_row(const GridDims& g, const T* v, index j, T* buf) {
   const index nx = g.nx(), N = g.nodes();
   for (int c = 0; c < 3; ++c)
     for (index iz = 0; iz < g.nz(); ++iz) std::copy_n(v + c * N + g.node(0, j, iz), nx, buf + (c * g.nz() + iz) * nx);
 }
-void unpack_row(const GridDims& g, const real* buf, index j, real* v) {
+template <class T>
+void unpack_row(const GridDims& g, const T* buf, index j, T* v) {
   const index nx = g.nx(), N = g.nodes();
   for (int c = 0; c < 3; ++c)
     for (index iz = 0; iz < g.nz(); ++iz) std::copy_n(buf + (c * g.nz() + iz) * nx, nx, v + c * N + g.node(0, j, iz));
 }
-void fill_row(const GridDims& g, real value, index j, real* v) {
+template <class T>
+void fill_row(const GridDims& g, T value, index j, T* v) {
   const index nx = g.nx(), N = g.nodes();
   for (int c = 0; c < 3; ++c)
     for (index iz = 0; iz < g.nz(); ++iz) std::fill_n(v + c * N + g.node(0, j, iz), nx, value);
 }
+#ifdef TRESCA_HAVE_MPI
+template <class T>
+MPI_Datatype mpi_type() {
+  return sizeof(T) == sizeof(double) ? MPI_DOUBLE : MPI_FLOAT;
+}
+#endif
 }  // namespace
 
+template <>
+std::vector<real>* DistributedElasticity::buffers<real>() const {
+  return buf_d_;
+}
+template <>
+std::vector<float>* DistributedElasticity::buffers<float>() const {
+  return buf_s_;
+}
+
 DistributedElasticity::DistributedElasticity(const Slab& s, unsigned faces, real E, real nu, const Comm& comm)
-    : slab_(s), comm_(comm), k_(build_elasticity_stencil(s.local, s.local_faces(faces), E, nu, {s.global.hx(), s.global.hy(), s.global.hz()})) {
+    : slab_(s),
+      comm_(comm),
+      k_(build_elasticity_stencil(s.local, s.local_faces(faces), E, nu, {s.global.hx(), s.global.hy(), s.global.hz()})),
+      kf_(stencil_in_precision<float>(k_)) {
   const index row = 3 * s.local.nx() * s.local.nz();
-  if (s.lo) send_lo_.resize(row), recv_lo_.resize(row);
-  if (s.hi) send_hi_.resize(row), recv_hi_.resize(row);
+  for (int i = 0; i < 4; ++i)
+    if ((i % 2 == 0 && s.lo) || (i % 2 == 1 && s.hi)) buf_d_[i].resize(row), buf_s_[i].resize(row);
 #ifdef TRESCA_HAVE_MPI
   requests_.resize(4 * sizeof(MPI_Request));
 #endif
 }
 
-void DistributedElasticity::begin_exchange(const real* x) const {
+template <class T>
+void DistributedElasticity::begin_exchange(const T* x) const {
   pending_ = 0;
   if (!slab_.lo && !slab_.hi) return;
 #ifdef TRESCA_HAVE_MPI
   MPI_Request* req = reinterpret_cast<MPI_Request*>(requests_.data());
   const GridDims& g = slab_.local;
   const int n = int(3 * g.nx() * g.nz());
+  std::vector<T>* buf = buffers<T>();  // send below, send above, receive below, receive above
+  const MPI_Datatype type = mpi_type<T>();
   // tag 0: a row travelling up (from rank r to r + 1), tag 1: down
-  if (slab_.lo) MPI_Irecv(recv_lo_.data(), n, MPI_DOUBLE, slab_.rank - 1, 0, MPI_COMM_WORLD, &req[pending_++]);
-  if (slab_.hi) MPI_Irecv(recv_hi_.data(), n, MPI_DOUBLE, slab_.rank + 1, 1, MPI_COMM_WORLD, &req[pending_++]);
+  if (slab_.lo) MPI_Irecv(buf[2].data(), n, type, slab_.rank - 1, 0, MPI_COMM_WORLD, &req[pending_++]);
+  if (slab_.hi) MPI_Irecv(buf[3].data(), n, type, slab_.rank + 1, 1, MPI_COMM_WORLD, &req[pending_++]);
   if (slab_.lo) {
-    pack_row(g, x, slab_.lo, send_lo_.data());
-    MPI_Isend(send_lo_.data(), n, MPI_DOUBLE, slab_.rank - 1, 1, MPI_COMM_WORLD, &req[pending_++]);
+    pack_row(g, x, slab_.lo, buf[0].data());
+    MPI_Isend(buf[0].data(), n, type, slab_.rank - 1, 1, MPI_COMM_WORLD, &req[pending_++]);
   }
   if (slab_.hi) {
-    pack_row(g, x, slab_.lo + slab_.owned_rows() - 1, send_hi_.data());
-    MPI_Isend(send_hi_.data(), n, MPI_DOUBLE, slab_.rank + 1, 0, MPI_COMM_WORLD, &req[pending_++]);
+    pack_row(g, x, slab_.lo + slab_.owned_rows() - 1, buf[1].data());
+    MPI_Isend(buf[1].data(), n, type, slab_.rank + 1, 0, MPI_COMM_WORLD, &req[pending_++]);
   }
   counts_.exchanges += 1;
   counts_.messages += slab_.lo + slab_.hi;
-  counts_.bytes += double(slab_.lo + slab_.hi) * n * sizeof(real);
+  counts_.bytes += double(slab_.lo + slab_.hi) * n * sizeof(T);
 #else
   (void)x;
 #endif
@@ -75,7 +100,8 @@ void DistributedElasticity::test_exchange() const {
 #endif
 }
 
-void DistributedElasticity::end_exchange(real* x) const {
+template <class T>
+void DistributedElasticity::end_exchange(T* x) const {
   if (!slab_.lo && !slab_.hi) return;
 #ifdef TRESCA_HAVE_MPI
   const double t0 = wall_time();
@@ -83,8 +109,9 @@ void DistributedElasticity::end_exchange(real* x) const {
   counts_.wait_seconds += wall_time() - t0;
   pending_ = 0;
   const GridDims& g = slab_.local;
-  if (slab_.lo) unpack_row(g, recv_lo_.data(), 0, x);
-  if (slab_.hi) unpack_row(g, recv_hi_.data(), slab_.lo + slab_.owned_rows(), x);
+  const std::vector<T>* buf = buffers<T>();
+  if (slab_.lo) unpack_row(g, buf[2].data(), 0, x);
+  if (slab_.hi) unpack_row(g, buf[3].data(), slab_.lo + slab_.owned_rows(), x);
 #else
   (void)x;
 #endif
@@ -95,15 +122,25 @@ void DistributedElasticity::exchange(real* x) const {
   end_exchange(x);
 }
 
-void DistributedElasticity::apply_rows(const real* x, real* y, index y_begin, index y_end) const {
+template <class T>
+void DistributedElasticity::apply_rows(const T* x, T* y, index y_begin, index y_end, const T* b) const {
   if (y_begin >= y_end) return;
   const GridDims& g = slab_.local;
-  ScopedTimer t(Kernel::apply, double(g.nx() * (y_end - y_begin) * g.nz()) * kApplyCost);
-  elasticity_apply(k_, x, y, RowBlock{0, g.nz(), y_begin, y_end});
+  ScopedTimer t(Kernel::apply, double(g.nx() * (y_end - y_begin) * g.nz()) * in_precision<T>(b ? kResidualCost : kApplyCost));
+  if constexpr (std::is_same<T, float>::value)
+    elasticity_apply(kf_, x, y, RowBlock{0, g.nz(), y_begin, y_end}, b);
+  else
+    elasticity_apply(k_, x, y, RowBlock{0, g.nz(), y_begin, y_end}, b);
 }
 
-void DistributedElasticity::apply(const real* x, real* y) const {
-  real* xg = const_cast<real*>(x);  // ghost rows only: communication scratch (header)
+void DistributedElasticity::apply(const real* x, real* y) const { apply_impl<real>(x, y, nullptr); }
+void DistributedElasticity::residual(const real* b, const real* x, real* r) const { apply_impl<real>(x, r, b); }
+void DistributedElasticity::apply(const float* x, float* y) const { apply_impl<float>(x, y, nullptr); }
+void DistributedElasticity::residual(const float* b, const float* x, float* r) const { apply_impl<float>(x, r, b); }
+
+template <class T>
+void DistributedElasticity::apply_impl(const T* x, T* y, const T* b) const {
+  T* xg = const_cast<T*>(x);  // ghost rows only: communication scratch (header)
   const index first = slab_.lo, last = slab_.lo + slab_.owned_rows();  // owned local rows [first, last)
   if (overlap_) {
     begin_exchange(x);
@@ -113,23 +150,27 @@ void DistributedElasticity::apply(const real* x, real* y) const {
     const index r0 = first + slab_.lo, r1 = std::max(r0, last - slab_.hi);
     const index chunks = slab_.lo + slab_.hi == 0 ? 1 : std::min<index>(kProgressChunks, std::max<index>(1, r1 - r0));
     for (index c = 0; c < chunks; ++c) {
-      apply_rows(x, y, r0 + (r1 - r0) * c / chunks, r0 + (r1 - r0) * (c + 1) / chunks);
+      apply_rows(x, y, r0 + (r1 - r0) * c / chunks, r0 + (r1 - r0) * (c + 1) / chunks, b);
       if (c + 1 < chunks) test_exchange();
     }
     end_exchange(xg);
-    if (slab_.lo) apply_rows(x, y, first, std::min(first + 1, last));
-    if (slab_.hi && last - 1 >= first + slab_.lo) apply_rows(x, y, last - 1, last);
+    if (slab_.lo) apply_rows(x, y, first, std::min(first + 1, last), b);
+    if (slab_.hi && last - 1 >= first + slab_.lo) apply_rows(x, y, last - 1, last, b);
   } else {
-    exchange(xg);
-    apply_rows(x, y, first, last);
+    begin_exchange(x);
+    end_exchange(xg);
+    apply_rows(x, y, first, last, b);
   }
   zero_ghosts(y);
 }
 
-void DistributedElasticity::zero_ghosts(real* v) const {
-  if (slab_.lo) fill_row(slab_.local, 0, 0, v);
-  if (slab_.hi) fill_row(slab_.local, 0, slab_.lo + slab_.owned_rows(), v);
+template <class T>
+void DistributedElasticity::zero_ghosts(T* v) const {
+  if (slab_.lo) fill_row(slab_.local, T(0), 0, v);
+  if (slab_.hi) fill_row(slab_.local, T(0), slab_.lo + slab_.owned_rows(), v);
 }
+template void DistributedElasticity::zero_ghosts<real>(real*) const;
+template void DistributedElasticity::zero_ghosts<float>(float*) const;
 
 void DistributedElasticity::diagonal(real* d) const {
   elasticity_diagonal(k_, d);

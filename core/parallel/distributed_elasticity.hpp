@@ -41,12 +41,19 @@ class DistributedElasticity : public LinearOperator {
   DistributedElasticity(const Slab& s, unsigned faces, real E, real nu, const Comm& comm = Comm::world());
   index size() const override { return 3 * slab_.local.nodes(); }
   void apply(const real* x, real* y) const override;
+  // r = b - K x on the owned rows (fused into the apply), 0 on the ghost rows
+  void residual(const real* b, const real* x, real* r) const;
+  // the same in single precision (coefficients rounded to float, messages of
+  // floats): the multigrid V-cycle's (distributed_multigrid.hpp)
+  void apply(const float* x, float* y) const;
+  void residual(const float* b, const float* x, float* r) const;
   // ghost rows of x := the neighbours' owned rows (blocking)
   void exchange(real* x) const;
   // diag(K) on the owned rows (1 on constrained dofs), 0 on the ghost rows
   void diagonal(real* d) const;
   // zero the ghost rows of a local vector
-  void zero_ghosts(real* v) const;
+  template <class T>
+  void zero_ghosts(T* v) const;
   const Slab& slab() const { return slab_; }
   const Comm& comm() const { return comm_; }
   const HaloCounts& counts() const { return counts_; }
@@ -54,18 +61,27 @@ class DistributedElasticity : public LinearOperator {
   void set_overlap(bool on) { overlap_ = on; }
 
  private:
-  void begin_exchange(const real* x) const;
-  void end_exchange(real* x) const;
+  template <class T>
+  void begin_exchange(const T* x) const;
+  template <class T>
+  void end_exchange(T* x) const;
   void test_exchange() const;  // lets MPI progress the messages (MPI_Testall)
   static constexpr index kProgressChunks = 8;
-  void apply_rows(const real* x, real* y, index y_begin, index y_end) const;
+  template <class T>
+  void apply_rows(const T* x, T* y, index y_begin, index y_end, const T* b) const;
+  template <class T>
+  void apply_impl(const T* x, T* y, const T* b) const;
+  template <class T>
+  std::vector<T>* buffers() const;  // send below, send above, receive below, receive above
 
   Slab slab_;
   const Comm& comm_;
   ElasticityStencil k_;
+  ElasticityStencilT<float> kf_;
   bool overlap_ = true;
   mutable HaloCounts counts_;
-  mutable std::vector<real> send_lo_, send_hi_, recv_lo_, recv_hi_;
+  mutable std::vector<real> buf_d_[4];
+  mutable std::vector<float> buf_s_[4];
   mutable std::vector<char> requests_;  // MPI_Request storage (opaque here)
   mutable int pending_ = 0;  // requests in flight; negative: all completed by a test
 };

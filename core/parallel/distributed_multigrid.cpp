@@ -5,12 +5,23 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
 
 namespace tresca {
+
+// The V-cycle's vectors of one level in precision T.
+template <class T>
+struct DistributedMultigrid::Work {
+  ElasticityStencilT<T> k;  // replicated levels: the whole grid's stencil
+  std::vector<T> dinv;      // 1 / diag, 0 on ghost rows
+  mutable std::vector<T> x, b, r, d, fine_rows, coarse_rows;
+  mutable T* xp = nullptr;  // iterate and right-hand side in use
+  mutable const T* bp = nullptr;
+};
 
 // One level: distributed (slab, A with ghost exchange) or replicated (the
 // whole grid's operator on every rank).
@@ -20,17 +31,23 @@ struct DistributedMultigrid::Level {
   Slab slab;                                  // distributed: this rank's; replicated: the whole grid
   std::unique_ptr<DistributedElasticity> Ad;  // distributed
   ElasticityOperator Ar;                      // replicated
-  std::vector<real> dinv;
-  mutable std::vector<real> x, b, r, d;
-  mutable real* xp = nullptr;        // iterate and right-hand side in use (the caller's on level 0)
-  mutable const real* bp = nullptr;
+  std::vector<real> dinv;  // double, for the Lanczos estimate
+  Work<real> wd;
+  Work<float> ws;
   real lmax = 0;
   index n = 0;  // local vector size
   // to the next coarser level
   std::unique_ptr<RowFetch> fetch_fine;    // the fine rows (of r here) the coarse rows restrict from
   std::unique_ptr<RowFetch> fetch_coarse;  // the coarse rows (of x there) this level interpolates from
   Transfer restrict_t, prolong_t;
-  mutable std::vector<real> fine_rows, coarse_rows;
+  template <class T>
+  const Work<T>& work() const {
+    if constexpr (std::is_same<T, float>::value) return ws; else return wd;
+  }
+  template <class T>
+  Work<T>& work() {
+    if constexpr (std::is_same<T, float>::value) return ws; else return wd;
+  }
   const LinearOperator& A() const { return distributed ? static_cast<const LinearOperator&>(*Ad) : Ar; }
 };
 
@@ -77,12 +94,6 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
       lv->dinv = lv->Ar.diagonal();
     }
     for (real& v : lv->dinv) v = v != 0 ? 1 / v : 0;  // ghost rows: 0
-    lv->x.resize(lv->n);
-    lv->b.resize(lv->n);
-    lv->r.resize(lv->n);
-    lv->d.resize(lv->n);
-    lv->xp = lv->x.data();
-    lv->bp = lv->b.data();
     levels_.push_back(std::move(lv));
   }
   // transfers
@@ -103,7 +114,6 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
       for (index k = Y.tstart[j]; k < Y.tstart[j + 1]; ++k) a = std::min(a, Y.tf[k]), b = std::max(b, Y.tf[k] + 1);
     if (b - a < 2) b = std::min(f.g.ny(), a + 2), a = b - 2;
     f.fetch_fine = std::make_unique<RowFetch>(f.slab, a, b, comm);
-    f.fine_rows.resize(3 * f.fetch_fine->box().nodes());
     f.restrict_t = slice_rows(T, a, b, c0, c1);
     // prolongation onto the fine local rows [f0, f1): the coarse rows they interpolate from
     index ca = c.g.ny(), cb = 0;
@@ -112,7 +122,6 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
     if (cb - ca < 2) ca = cb - 2;
     if (c.distributed) {
       f.fetch_coarse = std::make_unique<RowFetch>(c.slab, ca, cb, comm);
-      f.coarse_rows.resize(3 * f.fetch_coarse->box().nodes());
       f.prolong_t = slice_rows(T, f0, f1, ca, cb);
     } else {
       f.prolong_t = slice_rows(T, f0, f1, 0, c.g.ny());  // the coarse vector is whole here
@@ -124,9 +133,27 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
   if (coarse_.info() != Eigen::Success) throw std::runtime_error("distributed multigrid: coarse factorisation failed");
   cb_.resize(A.rows());
   cx_.resize(A.rows());
+  if (opt_.precision == Precision::single_precision)
+    build_work<float>();
+  else
+    build_work<real>();
 }
 
 DistributedMultigrid::~DistributedMultigrid() = default;
+
+template <class T>
+void DistributedMultigrid::build_work() {
+  for (auto& lv : levels_) {
+    Work<T>& w = lv->work<T>();
+    if (!lv->distributed) w.k = stencil_in_precision<T>(lv->Ar.stencil());
+    w.dinv.assign(lv->dinv.begin(), lv->dinv.end());
+    for (auto* v : {&w.x, &w.b, &w.r, &w.d}) v->resize(lv->n);
+    if (lv->fetch_fine) w.fine_rows.resize(3 * lv->fetch_fine->box().nodes());
+    if (lv->fetch_coarse) w.coarse_rows.resize(3 * lv->fetch_coarse->box().nodes());
+    w.xp = w.x.data();
+    w.bp = w.b.data();
+  }
+}
 
 index DistributedMultigrid::size() const { return levels_[0]->n; }
 const LinearOperator& DistributedMultigrid::op() const { return levels_[0]->A(); }
@@ -180,85 +207,96 @@ void DistributedMultigrid::estimate_lmax(Level& lv) {
   lv.lmax = 1.15 * std::max(es.eigenvalues().maxCoeff(), real(2));
 }
 
-void DistributedMultigrid::residual(const Level& lv, const real* b, const real* x, real* r) const {
-  if (!lv.distributed) {
-    lv.Ar.residual(b, x, r);
+template <class T>
+void DistributedMultigrid::residual(const Level& lv, const T* b, const T* x, T* r) const {
+  if (lv.distributed) {
+    lv.Ad->residual(b, x, r);
     return;
   }
-  lv.Ad->apply(x, r);  // ghost rows of r: 0, as b's
-  const index n = lv.n;
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * kXpayCost))
-  for (index i = 0; i < n; ++i) r[i] = b[i] - r[i];
+  const GridDims& g = lv.g;
+  ScopedTimer t(Kernel::apply, double(g.nodes()) * in_precision<T>(kResidualCost));
+  elasticity_apply<T>(lv.work<T>().k, x, r, 0, g.nz(), b);
 }
 
+template <class T>
 void DistributedMultigrid::smooth(int l, bool zero_guess) const {
   const Level& lv = *levels_[l];
+  const Work<T>& w = lv.work<T>();
   const index n = lv.n;
   ScopedTimer t(Kernel::smoother);
   const real lmax = lv.lmax, lmin = lmax / opt_.range;
   const real theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
-  real *x = lv.xp, *r = lv.r.data(), *d = lv.d.data();
+  T *x = w.xp, *r = w.r.data(), *d = w.d.data();
   if (zero_guess) {
-    cheb_first<real>(n, 1 / theta, lv.dinv.data(), lv.bp, d, x);
+    cheb_first<T>(n, T(1 / theta), w.dinv.data(), w.bp, d, x);
   } else {
-    residual(lv, lv.bp, x, r);
-    fill<real>(n, 0, d);
-    cheb_update<real>(n, 0, 1 / theta, lv.dinv.data(), r, d, x);
+    residual<T>(lv, w.bp, x, r);
+    fill<T>(n, 0, d);
+    cheb_update<T>(n, 0, T(1 / theta), w.dinv.data(), r, d, x);
   }
   real rho = 1 / sigma;
   for (int k = 1; k < opt_.degree; ++k) {
-    residual(lv, lv.bp, x, r);
+    residual<T>(lv, w.bp, x, r);
     const real rho_new = 1 / (2 * sigma - rho);
-    cheb_update<real>(n, rho_new * rho, 2 * rho_new / delta, lv.dinv.data(), r, d, x);
+    cheb_update<T>(n, T(rho_new * rho), T(2 * rho_new / delta), w.dinv.data(), r, d, x);
     rho = rho_new;
   }
 }
 
+template <class T>
 void DistributedMultigrid::vcycle(int l) const {
   const Level& lv = *levels_[l];
+  const Work<T>& w = lv.work<T>();
   if (l + 1 == int(levels_.size())) {
     ScopedTimer t(Kernel::coarse_solve);
-    for (index i = 0; i < lv.n; ++i) cb_[i] = lv.bp[i];
+    for (index i = 0; i < lv.n; ++i) cb_[i] = real(w.bp[i]);
     cx_ = coarse_.solve(cb_);
-    for (index i = 0; i < lv.n; ++i) lv.xp[i] = cx_[i];
+    for (index i = 0; i < lv.n; ++i) w.xp[i] = T(cx_[i]);
     return;
   }
   const Level& c = *levels_[l + 1];
-  smooth(l, true);
-  residual(lv, lv.bp, lv.xp, lv.r.data());
+  const Work<T>& cw = c.work<T>();
+  smooth<T>(l, true);
+  residual<T>(lv, w.bp, w.xp, w.r.data());
   {
-    ScopedTimer t(Kernel::restrict_, double(lv.n) * kRestrictCost);
-    const real* fine = lv.r.data();
+    ScopedTimer t(Kernel::restrict_, double(lv.n) * in_precision<T>(kRestrictCost));
+    const T* fine = w.r.data();
     if (lv.fetch_fine) {
-      lv.fetch_fine->fetch(lv.r.data(), lv.fine_rows.data());
-      fine = lv.fine_rows.data();
+      lv.fetch_fine->fetch<T>(w.r.data(), w.fine_rows.data());
+      fine = w.fine_rows.data();
     }
-    restrict_to_coarse<real>(lv.restrict_t, 3, fine, c.b.data());
-    zero_constrained<real>(c.slab.local, c.slab.local_faces(faces_), c.b.data());
-    if (c.distributed) c.Ad->zero_ghosts(c.b.data());
+    restrict_to_coarse<T>(lv.restrict_t, 3, fine, cw.b.data());
+    zero_constrained<T>(c.slab.local, c.slab.local_faces(faces_), cw.b.data());
+    if (c.distributed) c.Ad->zero_ghosts(cw.b.data());
   }
-  vcycle(l + 1);
+  vcycle<T>(l + 1);
   {
-    ScopedTimer t(Kernel::prolongate, double(lv.n) * kProlongateCost);
-    const real* coarse = c.x.data();
+    ScopedTimer t(Kernel::prolongate, double(lv.n) * in_precision<T>(kProlongateCost));
+    const T* coarse = cw.x.data();
     if (lv.fetch_coarse) {
-      lv.fetch_coarse->fetch(c.x.data(), lv.coarse_rows.data());
-      coarse = lv.coarse_rows.data();
+      lv.fetch_coarse->fetch<T>(cw.x.data(), w.coarse_rows.data());
+      coarse = w.coarse_rows.data();
     }
-    prolongate<real>(lv.prolong_t, 3, coarse, lv.xp, true);
-    zero_constrained<real>(lv.slab.local, lv.slab.local_faces(faces_), lv.xp);
+    prolongate<T>(lv.prolong_t, 3, coarse, w.xp, true);
+    zero_constrained<T>(lv.slab.local, lv.slab.local_faces(faces_), w.xp);
   }
-  smooth(l, false);
+  smooth<T>(l, false);
 }
 
 void DistributedMultigrid::apply(const real* r, real* z) const {
-  Level& f = *levels_[0];
-  f.bp = r;
-  f.xp = z;
-  vcycle(0);
+  const Level& f = *levels_[0];
+  if (opt_.precision == Precision::double_precision) {
+    f.wd.bp = r;
+    f.wd.xp = z;
+    vcycle<real>(0);
+    f.wd.bp = f.wd.b.data();
+    f.wd.xp = f.wd.x.data();
+  } else {
+    convert<float>(f.n, r, f.ws.b.data());
+    vcycle<float>(0);
+    convert<double>(f.n, f.ws.x.data(), z);
+  }
   if (f.distributed) f.Ad->zero_ghosts(z);
-  f.bp = f.b.data();
-  f.xp = f.x.data();
 }
 
 double DistributedMultigrid::cycle_work() const {
@@ -271,7 +309,8 @@ std::string DistributedMultigrid::describe() const {
   std::ostringstream os;
   os << levels_.size() << " levels:";
   for (const auto& lv : levels_) os << " " << lv->g.ex << "x" << lv->g.ey << "x" << lv->g.ez << (lv->distributed ? "(d)" : "");
-  os << " (double precision; (d): distributed over " << comm_.size() << " ranks, others replicated)";
+  os << " (" << to_string(opt_.precision) << " precision; (d): distributed over " << comm_.size()
+     << " ranks, others replicated)";
   return os.str();
 }
 

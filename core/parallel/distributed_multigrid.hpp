@@ -1,8 +1,9 @@
 // The geometric-multigrid V-cycle of multigrid.hpp on y-slabs (issue 12,
 // phase 2): the same hierarchy (GridHierarchy::build), smoother (Chebyshev
 // of degree d in D^{-1} A, bounds from a Lanczos estimate), transfers
-// (trilinear, non-nested) and coarsest solve (Eigen LDLT), in double
-// precision, with the work split over the ranks:
+// (trilinear, non-nested), coarsest solve (Eigen LDLT, double) and
+// precision (MGOptions::precision: single by default, as there: the
+// V-cycle in float inside the double CG), with the work split over the ranks:
 //
 // * fine levels are distributed: each rank holds its slab of the level
 //   (make_slab of that level's grid) and applies A with ghost exchange
@@ -17,9 +18,9 @@
 //   fine rows a coarse slab restricts from; at the first replicated level
 //   the fine residual is gathered whole.
 //
-// One rank: every level replicated, i.e. multigrid.hpp's V-cycle in double
-// precision (up to the Lanczos start vector, here a hash of the global
-// index so that it does not depend on the rank count).
+// One rank: every level replicated, i.e. multigrid.hpp's V-cycle (up to the
+// Lanczos start vector, here a hash of the global index so that it does
+// not depend on the rank count).
 #pragma once
 #include <Eigen/SparseCholesky>
 #include <memory>
@@ -55,9 +56,16 @@ class DistributedMultigrid : public LinearOperator {
 
  private:
   struct Level;
+  template <class T>
+  struct Work;
+  template <class T>
+  void build_work();
   void estimate_lmax(Level& lv);
-  void residual(const Level& lv, const real* b, const real* x, real* r) const;
+  template <class T>
+  void residual(const Level& lv, const T* b, const T* x, T* r) const;
+  template <class T>
   void smooth(int l, bool zero_guess) const;
+  template <class T>
   void vcycle(int l) const;
 
   MGOptions opt_;

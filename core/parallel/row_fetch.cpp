@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #ifdef TRESCA_HAVE_MPI
 #include <mpi.h>
@@ -19,13 +20,15 @@ GridDims row_box(const GridDims& g, index a, index b) {
 }
 
 namespace {
-// rows [r0, r1) of all planes and components: from grid ga at row ra to grid gb at row rb, or packed
-void rows_to_buffer(const GridDims& g, const real* v, index r0, index r1, real* buf) {
+// rows [r0, r1) of all planes and components of a vector on grid g <-> packed
+template <class T>
+void rows_to_buffer(const GridDims& g, const T* v, index r0, index r1, T* buf) {
   const index nx = g.nx(), N = g.nodes(), len = (r1 - r0) * nx;
   for (int c = 0; c < 3; ++c)
     for (index iz = 0; iz < g.nz(); ++iz, buf += len) std::copy_n(v + c * N + g.node(0, r0, iz), len, buf);
 }
-void buffer_to_rows(const GridDims& g, const real* buf, index r0, index r1, real* v) {
+template <class T>
+void buffer_to_rows(const GridDims& g, const T* buf, index r0, index r1, T* v) {
   const index nx = g.nx(), N = g.nodes(), len = (r1 - r0) * nx;
   for (int c = 0; c < 3; ++c)
     for (index iz = 0; iz < g.nz(); ++iz, buf += len) std::copy_n(buf, len, v + c * N + g.node(0, r0, iz));
@@ -66,24 +69,36 @@ RowFetch::RowFetch(const Slab& s, index a, index b, const Comm& comm) : s_(s), c
     if (q != comm.rank()) bytes_ += double(send_counts_[q]) * sizeof(real);
   }
   if (ro != int((b - a) * plane_row)) throw std::logic_error("RowFetch: the owners do not cover the rows");
-  send_.resize(so);
-  recv_.resize(ro);
+  send_total_ = so;
+  recv_total_ = ro;
 }
 
-void RowFetch::fetch(const real* local, real* out) const {
+template <class T>
+void RowFetch::fetch(const T* local, T* out) const {
   const int P = comm_.size();
+  std::vector<T>& send = [&]() -> std::vector<T>& {
+    if constexpr (std::is_same<T, float>::value) return send_s_; else return send_d_;
+  }();
+  std::vector<T>& recv = [&]() -> std::vector<T>& {
+    if constexpr (std::is_same<T, float>::value) return recv_s_; else return recv_d_;
+  }();
+  send.resize(send_total_);
+  recv.resize(recv_total_);
   for (int q = 0; q < P; ++q)
     if (send_counts_[q])
-      rows_to_buffer(s_.local, local, s_.local_row(send_lo_[q]), s_.local_row(send_hi_[q]), send_.data() + send_displs_[q]);
+      rows_to_buffer(s_.local, local, s_.local_row(send_lo_[q]), s_.local_row(send_hi_[q]), send.data() + send_displs_[q]);
 #ifdef TRESCA_HAVE_MPI
-  if (P > 1)
-    MPI_Alltoallv(send_.data(), send_counts_.data(), send_displs_.data(), MPI_DOUBLE, recv_.data(), recv_counts_.data(),
-                  recv_displs_.data(), MPI_DOUBLE, MPI_COMM_WORLD);
-  else
+  if (P > 1) {
+    const MPI_Datatype type = std::is_same<T, float>::value ? MPI_FLOAT : MPI_DOUBLE;
+    MPI_Alltoallv(send.data(), send_counts_.data(), send_displs_.data(), type, recv.data(), recv_counts_.data(),
+                  recv_displs_.data(), type, MPI_COMM_WORLD);
+  } else
 #endif
-    std::copy(send_.begin(), send_.end(), recv_.begin());
+    std::copy(send.begin(), send.end(), recv.begin());
   for (int q = 0; q < P; ++q)
-    if (recv_counts_[q]) buffer_to_rows(box_, recv_.data() + recv_displs_[q], recv_lo_[q] - a_, recv_hi_[q] - a_, out);
+    if (recv_counts_[q]) buffer_to_rows(box_, recv.data() + recv_displs_[q], recv_lo_[q] - a_, recv_hi_[q] - a_, out);
 }
+template void RowFetch::fetch<real>(const real*, real*) const;
+template void RowFetch::fetch<float>(const float*, float*) const;
 
 }  // namespace tresca

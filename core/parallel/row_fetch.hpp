@@ -25,7 +25,9 @@ class RowFetch {
   index first_row() const { return a_; }
   // out (3 * box().nodes()) := rows [a, b) of the distributed vector whose
   // local part (slab's local box) is `local`
-  void fetch(const real* local, real* out) const;
+  // (T = double or float)
+  template <class T>
+  void fetch(const T* local, T* out) const;
   double bytes_per_fetch() const { return bytes_; }
 
  private:
@@ -36,7 +38,9 @@ class RowFetch {
   // per rank q: rows [send_lo, send_hi) of mine go to q, rows [recv_lo, recv_hi) of my box come from q
   std::vector<index> send_lo_, send_hi_, recv_lo_, recv_hi_;
   std::vector<int> send_counts_, send_displs_, recv_counts_, recv_displs_;
-  mutable std::vector<real> send_, recv_;
+  mutable std::vector<real> send_d_, recv_d_;
+  mutable std::vector<float> send_s_, recv_s_;
+  int send_total_ = 0, recv_total_ = 0;
   double bytes_ = 0;
 };
 
