@@ -14,6 +14,7 @@
 #include "core/parallel/distributed_multigrid.hpp"
 #include "core/parallel/row_fetch.hpp"
 #include "core/solvers/multigrid.hpp"
+#include "kernels/boundary_block.hpp"
 #include "core/solvers/cg.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"
@@ -194,6 +195,65 @@ TEST(DistributedMultigrid, CGMatchesTheWholeGridMultigrid) {
     EXPECT_NEAR(sd.iterations, sg.iterations, 1) << dmg.describe();
     EXPECT_LE(max_owned_diff(s, u, ug), 1e-8 * test::max_abs(ug)) << dmg.describe();
   }
+}
+
+// The Newton-step preconditioner's operator K + B (K clamped on x = 0 only,
+// B a random SPD 2x2 + 1 block per bottom node): MG-CG with the distributed
+// V-cycle (B projected to every level, each rank its rows) against the
+// whole grid's
+TEST(DistributedMultigrid, BottomBlockCGMatchesTheWholeGridMultigrid) {
+  const GridDims g = test::prism(24, 20, 8);
+  const index M = g.nx() * g.ny();
+  std::vector<real> B(4 * M);
+  const std::vector<real> rnd = test::random_vector(3 * M, 4);
+  for (index m = 0; m < M; ++m) {
+    B[m] = 4e9 * (1.5 + rnd[m]);
+    B[2 * M + m] = 4e9 * (1.5 + rnd[M + m]);
+    B[M + m] = 1e9 * rnd[2 * M + m];  // |bxy| < sqrt(bxx byy)
+    B[3 * M + m] = 1e12;              // a penalty, as on fixed dofs
+  }
+  MGOptions mo;
+  Multigrid mg(g, kFaceX0, 2.1e9, 0.277, mo);
+  mg.set_bottom_block(B);
+  DistributedMultigrid dmg(g, kFaceX0, 2.1e9, 0.277, mo, world(), 64);
+  dmg.set_bottom_block(B);
+  if (world().size() > 1) ASSERT_TRUE(dmg.fine_distributed());
+  std::vector<real> bg = test::random_vector(3 * g.nodes(), 9);
+  zero_constrained(g, unsigned(kFaceX0), bg.data());
+  CGOptions o;
+  o.rtol = 1e-9;
+  CGWorkspace ws;
+  std::vector<real> ug(bg.size());
+  const SolveStats sg = pcg(mg.op(0), &mg, bg.data(), ug.data(), o, ws);
+  ASSERT_TRUE(sg.ok());
+  // K + B on the slab: the rank's rows of B (ghost rows 0)
+  const Slab& s = dmg.fine_slab();
+  struct KB : LinearOperator {
+    const LinearOperator& K;
+    const Slab& s;
+    std::vector<real> Bl;
+    KB(const LinearOperator& K_, const Slab& s_, const std::vector<real>& B, const GridDims& g) : K(K_), s(s_) {
+      const index M = g.nx() * g.ny(), Ml = s.local.nx() * s.local.ny();
+      Bl.assign(4 * Ml, 0.0);
+      for (int f = 0; f < 4; ++f)
+        for (index iy = s.y_begin; iy < s.y_end; ++iy)
+          for (index ix = 0; ix < g.nx(); ++ix)
+            Bl[f * Ml + ix + s.local.nx() * s.local_row(iy)] = ix == 0 ? 0 : B[f * M + ix + g.nx() * iy];
+    }
+    index size() const override { return K.size(); }
+    void apply(const real* x, real* y) const override {
+      K.apply(x, y);
+      bottom_block_apply<real>(s.local, 1, Bl.data(), x, y);
+    }
+  } A(dmg.op(), s, B, g);
+  std::vector<real> b(dmg.size()), u(dmg.size());
+  global_to_local(s, bg.data(), b.data());
+  if (dmg.fine_distributed()) static_cast<const DistributedElasticity&>(dmg.op()).zero_ghosts(b.data());
+  o.comm = dmg.fine_distributed() ? &world() : nullptr;
+  const SolveStats sd = pcg(A, &dmg, b.data(), u.data(), o, ws);
+  ASSERT_TRUE(sd.ok()) << dmg.describe();
+  EXPECT_NEAR(sd.iterations, sg.iterations, 1) << dmg.describe();
+  EXPECT_LE(max_owned_diff(s, u, ug), 1e-7 * test::max_abs(ug)) << dmg.describe();
 }
 
 TEST(CommModel, BoxHalosAndTheRankGrid) {

@@ -5,8 +5,10 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
+#include "kernels/boundary_block.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
@@ -18,6 +20,7 @@ template <class T>
 struct DistributedMultigrid::Work {
   ElasticityStencilT<T> k;  // replicated levels: the whole grid's stencil
   std::vector<T> dinv;      // 1 / diag, 0 on ghost rows
+  std::vector<T> B;         // bottom block of this level's rows (empty: none; 0 on ghost rows)
   mutable std::vector<T> x, b, r, d, fine_rows, coarse_rows;
   mutable T* xp = nullptr;  // iterate and right-hand side in use
   mutable const T* bp = nullptr;
@@ -32,6 +35,7 @@ struct DistributedMultigrid::Level {
   std::unique_ptr<DistributedElasticity> Ad;  // distributed
   ElasticityOperator Ar;                      // replicated
   std::vector<real> dinv;  // double, for the Lanczos estimate
+  std::vector<real> B;     // distributed levels: the bottom block of the local rows (ghost rows 0)
   Work<real> wd;
   Work<float> ws;
   real lmax = 0;
@@ -71,7 +75,7 @@ void row_range(const Slab& s, index& first, index& last) {
 }  // namespace
 
 DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt,
-                                           const Comm& comm, index min_nodes_per_rank)
+                                           const Comm& comm, index min_nodes_per_rank, const DistributedMultigrid* like)
     : opt_(opt), comm_(comm), faces_(faces), grids_(GridHierarchy::build(fine, opt.coarse_nodes)) {
   const int P = comm.size();
   bool replicated = P == 1;
@@ -85,17 +89,17 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
       lv->slab = make_slab(g, comm.rank(), P);
       lv->Ad = std::make_unique<DistributedElasticity>(lv->slab, faces, E, nu, comm);
       lv->n = lv->Ad->size();
-      lv->dinv.resize(lv->n);
-      lv->Ad->diagonal(lv->dinv.data());
     } else {
       lv->slab = make_slab(g, 0, 1);
       lv->Ar = ElasticityOperator(g, faces, E, nu);
       lv->n = lv->Ar.size();
-      lv->dinv = lv->Ar.diagonal();
     }
-    for (real& v : lv->dinv) v = v != 0 ? 1 / v : 0;  // ghost rows: 0
     levels_.push_back(std::move(lv));
   }
+  if (!levels_[0]->distributed) op0_ = levels_[0]->Ar;  // K without the bottom block set later
+  refresh_diagonals();
+  if (like && (like->levels_.size() != levels_.size() || &like->comm_ != &comm_))
+    throw std::invalid_argument("distributed multigrid: spectral bounds can only be shared on the same hierarchy");
   // transfers
   for (size_t l = 0; l + 1 < levels_.size(); ++l) {
     Level &f = *levels_[l], &c = *levels_[l + 1];
@@ -127,12 +131,13 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
       f.prolong_t = slice_rows(T, f0, f1, 0, c.g.ny());  // the coarse vector is whole here
     }
   }
-  for (size_t l = 0; l + 1 < levels_.size(); ++l) estimate_lmax(*levels_[l]);
-  SparseMatrix A = assemble(levels_.back()->Ar);
-  coarse_.compute(A);
-  if (coarse_.info() != Eigen::Success) throw std::runtime_error("distributed multigrid: coarse factorisation failed");
-  cb_.resize(A.rows());
-  cx_.resize(A.rows());
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) {
+    if (like)
+      levels_[l]->lmax = like->levels_[l]->lmax;
+    else
+      estimate_lmax(*levels_[l]);
+  }
+  factor_coarse();
   if (opt_.precision == Precision::single_precision)
     build_work<float>();
   else
@@ -141,22 +146,118 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
 
 DistributedMultigrid::~DistributedMultigrid() = default;
 
+void DistributedMultigrid::factor_coarse() {
+  SparseMatrix A = assemble(levels_.back()->Ar);
+  coarse_.compute(A);
+  if (coarse_.info() != Eigen::Success) throw std::runtime_error("distributed multigrid: coarse factorisation failed");
+  cb_.resize(A.rows());
+  cx_.resize(A.rows());
+}
+
+void DistributedMultigrid::refresh_diagonals() {
+  for (auto& lv : levels_) {
+    if (lv->distributed) {
+      lv->dinv.resize(lv->n);
+      lv->Ad->diagonal(lv->dinv.data());
+      if (!lv->B.empty()) {
+        const GridDims& g = lv->slab.local;
+        const index M = g.nx() * g.ny(), N = g.nodes();
+        for (index m = 0; m < M; ++m) {
+          lv->dinv[m] += lv->B[m];
+          lv->dinv[N + m] += lv->B[2 * M + m];
+          lv->dinv[2 * N + m] += lv->B[3 * M + m];
+        }
+        lv->Ad->zero_ghosts(lv->dinv.data());
+      }
+    } else {
+      lv->dinv = lv->Ar.diagonal();
+    }
+    for (real& v : lv->dinv) v = v != 0 ? 1 / v : 0;  // ghost rows: 0
+  }
+}
+
+void DistributedMultigrid::set_bottom_block(const std::vector<real>& B) {
+  const GridDims& g0 = levels_[0]->g;
+  if (!B.empty() && index(B.size()) != 4 * g0.nx() * g0.ny())
+    throw std::invalid_argument("distributed multigrid: bottom block has " + std::to_string(B.size()) +
+                                " entries, expected 4 x " + std::to_string(g0.nx() * g0.ny()));
+  std::vector<real> Bl = B;  // this level's, whole plane
+  for (size_t l = 0; l < levels_.size(); ++l) {
+    Level& lv = *levels_[l];
+    const GridDims& g = lv.g;
+    const index M = g.nx() * g.ny();
+    if (!Bl.empty())  // zero on constrained nodes, as ElasticityOperator::set_bottom_block
+      for (index iy = 0; iy < g.ny(); ++iy)
+        for (index ix = 0; ix < g.nx(); ++ix)
+          if (node_constrained(g, faces_, ix, iy, 0))
+            for (int f = 0; f < 4; ++f) Bl[f * M + ix + g.nx() * iy] = 0;
+    if (lv.distributed) {
+      lv.B.clear();
+      if (!Bl.empty()) {
+        const GridDims& box = lv.slab.local;
+        const index Ml = box.nx() * box.ny(), row0 = lv.slab.y_begin - lv.slab.lo;
+        lv.B.assign(4 * Ml, 0.0);
+        for (int f = 0; f < 4; ++f)  // owned rows only: ghost rows stay 0
+          std::copy_n(Bl.data() + f * M + g.nx() * lv.slab.y_begin, g.nx() * lv.slab.owned_rows(),
+                      lv.B.data() + f * Ml + box.nx() * (lv.slab.y_begin - row0));
+      }
+    } else {
+      lv.Ar.set_bottom_block(Bl);
+    }
+    if (l + 1 == levels_.size()) break;
+    if (Bl.empty()) continue;
+    // P^T B, lumped per entry (multigrid.cpp)
+    const GridDims& cg = levels_[l + 1]->g;
+    const index Mc = cg.nx() * cg.ny();
+    const Interp1D &X = grids_->to_coarse[l].axis[0], &Y = grids_->to_coarse[l].axis[1];
+    std::vector<real> Bc(4 * Mc, 0.0);
+    for (int fld = 0; fld < 4; ++fld)
+      for (index jy = 0; jy < cg.ny(); ++jy)
+        for (index jx = 0; jx < cg.nx(); ++jx) {
+          real s = 0;
+          for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky)
+            for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx)
+              s += Y.tw[ky] * X.tw[kx] * Bl[fld * M + X.tf[kx] + g.nx() * Y.tf[ky]];
+          Bc[fld * Mc + jx + cg.nx() * jy] = s;
+        }
+    Bl = std::move(Bc);
+  }
+  refresh_diagonals();
+  factor_coarse();
+  if (opt_.precision == Precision::single_precision)
+    refresh_work<float>();
+  else
+    refresh_work<real>();
+}
+
+template <class T>
+void DistributedMultigrid::refresh_work() {
+  for (auto& lv : levels_) {
+    Work<T>& w = lv->work<T>();
+    w.dinv.assign(lv->dinv.begin(), lv->dinv.end());
+    const std::vector<real>& B = lv->distributed ? lv->B : lv->Ar.bottom_block();
+    w.B.assign(B.begin(), B.end());
+  }
+}
+
 template <class T>
 void DistributedMultigrid::build_work() {
   for (auto& lv : levels_) {
     Work<T>& w = lv->work<T>();
     if (!lv->distributed) w.k = stencil_in_precision<T>(lv->Ar.stencil());
-    w.dinv.assign(lv->dinv.begin(), lv->dinv.end());
     for (auto* v : {&w.x, &w.b, &w.r, &w.d}) v->resize(lv->n);
     if (lv->fetch_fine) w.fine_rows.resize(3 * lv->fetch_fine->box().nodes());
     if (lv->fetch_coarse) w.coarse_rows.resize(3 * lv->fetch_coarse->box().nodes());
     w.xp = w.x.data();
     w.bp = w.b.data();
   }
+  refresh_work<T>();
 }
 
 index DistributedMultigrid::size() const { return levels_[0]->n; }
-const LinearOperator& DistributedMultigrid::op() const { return levels_[0]->A(); }
+const LinearOperator& DistributedMultigrid::op() const {
+  return levels_[0]->distributed ? static_cast<const LinearOperator&>(*levels_[0]->Ad) : op0_;
+}
 bool DistributedMultigrid::fine_distributed() const { return levels_[0]->distributed; }
 const Slab& DistributedMultigrid::fine_slab() const { return levels_[0]->slab; }
 real DistributedMultigrid::lmax(int level) const { return levels_[level]->lmax; }
@@ -209,13 +310,18 @@ void DistributedMultigrid::estimate_lmax(Level& lv) {
 
 template <class T>
 void DistributedMultigrid::residual(const Level& lv, const T* b, const T* x, T* r) const {
+  const Work<T>& w = lv.work<T>();
   if (lv.distributed) {
     lv.Ad->residual(b, x, r);
-    return;
+  } else {
+    ScopedTimer t(Kernel::apply, double(lv.g.nodes()) * in_precision<T>(kResidualCost));
+    elasticity_apply<T>(w.k, x, r, 0, lv.g.nz(), b);
   }
-  const GridDims& g = lv.g;
-  ScopedTimer t(Kernel::apply, double(g.nodes()) * in_precision<T>(kResidualCost));
-  elasticity_apply<T>(lv.work<T>().k, x, r, 0, g.nz(), b);
+  if (!w.B.empty()) {  // B is 0 on ghost rows, which stay 0
+    const GridDims& g = lv.slab.local;
+    ScopedTimer t(Kernel::apply_boundary, double(g.nx() * g.ny()) * in_precision<T>(kBottomBlockCost));
+    bottom_block_apply<T>(g, T(-1), w.B.data(), x, r);
+  }
 }
 
 template <class T>

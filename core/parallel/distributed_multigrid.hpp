@@ -37,15 +37,24 @@ namespace tresca {
 
 class DistributedMultigrid : public LinearOperator {
  public:
+  // like: take the smoother bounds from that multigrid (same grid, options
+  // and rank count) instead of estimating them, as Multigrid's
   DistributedMultigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt = {},
-                       const Comm& comm = Comm::world(), index min_nodes_per_rank = 2048);
+                       const Comm& comm = Comm::world(), index min_nodes_per_rank = 2048,
+                       const DistributedMultigrid* like = nullptr);
   ~DistributedMultigrid() override;
   // on level-0 local vectors: the slab's local box if level 0 is
   // distributed, the whole grid if not (one rank)
   index size() const override;
   void apply(const real* r, real* z) const override;
-  // the fine operator on the same vectors (zero ghost rows on output)
+  // the fine operator K on the same vectors (zero ghost rows on output),
+  // without the bottom block
   const LinearOperator& op() const;
+  // B of the finest level over the WHOLE bottom plane (4 fields of nx*ny,
+  // elasticity_operator.hpp), the same on every rank (built from replicated
+  // contact data, so no messages): every level gets its projection P^T B
+  // (as Multigrid::set_bottom_block) and each rank keeps its rows of it
+  void set_bottom_block(const std::vector<real>& B);
   bool fine_distributed() const;
   const Slab& fine_slab() const;  // level 0's slab (the whole grid when replicated)
   int num_levels() const { return int(levels_.size()); }
@@ -60,6 +69,10 @@ class DistributedMultigrid : public LinearOperator {
   struct Work;
   template <class T>
   void build_work();
+  template <class T>
+  void refresh_work();
+  void refresh_diagonals();
+  void factor_coarse();
   void estimate_lmax(Level& lv);
   template <class T>
   void residual(const Level& lv, const T* b, const T* x, T* r) const;
@@ -73,6 +86,7 @@ class DistributedMultigrid : public LinearOperator {
   unsigned faces_;
   std::shared_ptr<const GridHierarchy> grids_;
   std::vector<std::unique_ptr<Level>> levels_;
+  ElasticityOperator op0_;  // K of a replicated level 0 (op())
   Eigen::SimplicialLDLT<SparseMatrix> coarse_;
   mutable Eigen::VectorXd cb_, cx_;
 };
