@@ -17,6 +17,7 @@
 #include "core/io/vtu.hpp"
 #include "core/util/profile.hpp"
 #include "core/contact/run.hpp"
+#include "core/parallel/comm.hpp"
 #include "kernels/simd.hpp"
 
 using namespace tresca;
@@ -94,7 +95,14 @@ const PaperRow* paper_row(int level) {
 
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
-  require_one_rank("tresca");
+  // Under mpirun with several ranks every rank runs this main: the 3D work is
+  // split into y-slabs (steklov.hpp), the contact iteration is the same on
+  // every rank, and rank 0 alone prints and writes the outputs.
+  MpiSession mpi(argc, argv);
+  const Comm& comm = Comm::world();
+  if (comm.rank() != 0) {
+    if (!std::freopen("/dev/null", "w", stdout) || !std::freopen("/dev/null", "w", stderr)) return 3;
+  }
   ProblemSpec spec;
   RunOptions opt;
   int threads = 1;
@@ -187,6 +195,9 @@ int main(int argc, char** argv) {
       outputs.push_back({vtk_path, "--vtk"});
       outputs.push_back({vtu_companion(vtk_path), "--vtk's contact file"});
     }
+    if (!vtk_path.empty() && comm.distributed())
+      throw std::invalid_argument("--vtk with " + std::to_string(comm.size()) +
+                                  " MPI ranks: the distributed VTU output (.pvtu) is not written yet; run --vtk on one rank");
     every_iteration = a.has("--vtk-every-iteration");
     if (every_iteration && (vtk_path.empty() || !table.empty()))
       throw std::invalid_argument("--vtk-every-iteration needs --vtk FILE.vtu (and no --table)");
@@ -213,6 +224,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());
     return 2;
   }
+  if (comm.rank() != 0) json_path = csv_path = "";  // outputs: rank 0's
 
   if (opt.newton.scaling == StepScaling::paper && (spec.E < 1e6 || spec.E > 1e12))
     std::fprintf(stderr,
@@ -298,10 +310,11 @@ int main(int argc, char** argv) {
         std::snprintf(friction, sizeof friction, "Coulomb F %g", opt.coulomb);
       else
         std::snprintf(friction, sizeof friction, "phi %g", spec.phi);
-      std::printf("tresca: mesh %s (level %s), %lld nodes, %lld contact nodes, %lld dofs, %s, obstacle %s, eps %g, %d threads\n",
+      std::printf("tresca: mesh %s (level %s), %lld nodes, %lld contact nodes, %lld dofs, %s, obstacle %s, eps %g, %d threads%s\n",
                   dims_string(spec).c_str(), spec.level >= 0 ? std::to_string(spec.level).c_str() : "-",
                   (long long)spec.nodes(), (long long)spec.contact_nodes(), (long long)spec.free_dofs(), friction,
-                  to_string(spec.obstacle.kind), opt.newton.eps, threads);
+                  to_string(spec.obstacle.kind), opt.newton.eps, threads,
+                  comm.distributed() ? (" per rank x " + std::to_string(comm.size()) + " MPI ranks (y-slabs)").c_str() : "");
       std::printf("        estimated peak memory %.2f GB; kernels: %s\n", estimated_memory_bytes(spec) / 1e9,
                   build_info().c_str());
     }

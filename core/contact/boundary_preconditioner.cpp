@@ -12,18 +12,17 @@ constexpr real kPenalty = 1e4;
 }  // namespace
 
 BoundaryPreconditioner::BoundaryPreconditioner(const SteklovPoincare& S, const MGOptions& mg)
-    : S_(S),
-      mg_(S.interior_multigrid().hierarchy(),  // the K_ii solver's grids, transfers and smoother bounds
-          elasticity_on(S.problem().dirichlet_faces, S.problem().spec.E, S.problem().spec.nu), mg,
-          S.interior_multigrid()) {
-  const GridDims& g = S.problem().grid;
-  const index M = g.nx() * g.ny(), N = g.nodes();
-  const std::vector<real> d = mg_.op(0).diagonal();
-  kdiag_bottom_.resize(3 * M);
-  for (int a = 0; a < 3; ++a)
-    for (index n = 0; n < M; ++n) kdiag_bottom_[a * M + n] = d[a * N + n];
-  full_in_.assign(3 * N, 0);
-  full_out_.assign(3 * N, 0);
+    : S_(S), kdiag_(S.contact_diagonal()) {
+  const Problem& P = S.problem();
+  // the K_ii solver's grids, transfers and smoother bounds
+  if (S.distributed())
+    dmg_ = std::make_unique<DistributedMultigrid>(P.grid, P.dirichlet_faces, P.spec.E, P.spec.nu, mg, S.comm(), 2048,
+                                                  &S.distributed_multigrid());
+  else
+    mg_ = std::make_unique<Multigrid>(S.interior_multigrid().hierarchy(),
+                                      elasticity_on(P.dirichlet_faces, P.spec.E, P.spec.nu), mg, S.interior_multigrid());
+  full_in_.assign(S.full_size(), 0);
+  full_out_.assign(S.full_size(), 0);
 }
 
 void BoundaryPreconditioner::update(const std::vector<real>& h, const std::vector<std::uint8_t>& fixed,
@@ -37,12 +36,15 @@ void BoundaryPreconditioner::update(const std::vector<real>& h, const std::vecto
   std::vector<real> B(4 * M, 0.0);
   for (index c = 0; c < p; ++c) {
     const index n = P.contact_grid_node(c);  // bottom plane: grid node index = plane index
-    B[0 * M + n] = fixed[c] ? kPenalty * kdiag_bottom_[n] : h[c];
+    B[0 * M + n] = fixed[c] ? kPenalty * kdiag_[c] : h[c];
     B[1 * M + n] = (fixed[c] || fixed[p + c]) ? 0 : h[p + c];
-    B[2 * M + n] = fixed[p + c] ? kPenalty * kdiag_bottom_[M + n] : h[2 * p + c];
-    B[3 * M + n] = fixed[2 * p + c] ? kPenalty * kdiag_bottom_[2 * M + n] : 0;
+    B[2 * M + n] = fixed[p + c] ? kPenalty * kdiag_[p + c] : h[2 * p + c];
+    B[3 * M + n] = fixed[2 * p + c] ? kPenalty * kdiag_[2 * p + c] : 0;
   }
-  mg_.set_bottom_block(B);
+  if (dmg_)
+    dmg_->set_bottom_block(B);
+  else
+    mg_->set_bottom_block(B);
   free_ = free_mask;
 }
 
@@ -50,7 +52,10 @@ void BoundaryPreconditioner::apply(const real* r, real* z) const {
   // full_in_ is zero off the contact nodes (set once; the scatter writes only
   // contact nodes and the V-cycle never writes its right-hand side)
   S_.scatter(r, full_in_.data());
-  mg_.apply(full_in_.data(), full_out_.data());
+  if (dmg_)
+    dmg_->apply(full_in_.data(), full_out_.data());
+  else
+    mg_->apply(full_in_.data(), full_out_.data());
   S_.gather(full_out_.data(), z);
   for (index i = 0; i < size(); ++i)
     if (!free_[i]) z[i] = 0;

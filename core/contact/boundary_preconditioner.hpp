@@ -12,12 +12,19 @@
 //
 // Cost per apply: one fine V-cycle (about one inner CG iteration), i.e. about
 // a tenth of one S application.
+//
+// Several ranks (S.distributed()): the V-cycle is DistributedMultigrid's;
+// B is built over the whole bottom plane on every rank from the (whole)
+// contact vectors, so setting it needs no messages.
 #pragma once
 #include <cstdint>
 #include <vector>
 
+#include <memory>
+
 #include "core/solvers/multigrid.hpp"
 #include "core/contact/steklov.hpp"
+#include "core/parallel/distributed_multigrid.hpp"
 
 namespace tresca {
 
@@ -31,15 +38,16 @@ class BoundaryPreconditioner : public LinearOperator {
   // on sliding nodes), `fixed` (3p bytes, 1 where the increment is known)
   // and `free` mask (3p bytes) of the reduced system.
   // work of one apply in fine-grid matvec equivalents (one V-cycle of K + B)
-  double apply_work() const { return mg_.cycle_work(); }
+  double apply_work() const { return dmg_ ? dmg_->cycle_work() : mg_->cycle_work(); }
 
   void update(const std::vector<real>& h, const std::vector<std::uint8_t>& fixed,
               const std::vector<std::uint8_t>& free_mask);
 
  private:
   const SteklovPoincare& S_;
-  Multigrid mg_;
-  std::vector<real> kdiag_bottom_;  // diag of K on the bottom plane (3 fields of nx*ny)
+  std::unique_ptr<Multigrid> mg_;             // one rank
+  std::unique_ptr<DistributedMultigrid> dmg_;  // several
+  std::vector<real> kdiag_;  // diag of K at the contact nodes (3 blocks of p)
   std::vector<std::uint8_t> free_;
   mutable std::vector<real> full_in_, full_out_;
 };

@@ -14,7 +14,7 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
   const std::vector<real>& phi = law.phi;
   FinalReport F;
   std::vector<real> Su(3 * p), v(4 * p), d(3 * p);
-  if (extension) extension->resize(3 * S.problem().nodes());
+  if (extension) extension->resize(S.full_size());
   real* ext = extension ? extension->data() : nullptr;
   F.inner = S.apply(R.u.data(), Su.data(), tight_rtol, ext, warm ? ext : nullptr);
   F.r.resize(3 * p);

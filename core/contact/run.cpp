@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/contact/nested.hpp"
+#include "core/parallel/comm.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
@@ -72,6 +73,11 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
       prolongate_contact(C.problem->grid, C.newton.u, C.newton.lambda, R.problem->grid, u0, lambda0);
       newton.u0 = &u0;
       newton.lambda0 = &lambda0;
+    }
+    // the 3D guesses are whole-grid vectors on one rank only (several
+    // ranks: the inner solves start cold; core/parallel has no transfer of
+    // slab vectors between meshes yet)
+    if (C.converged() && !Comm::world().distributed()) {
       const Transfer T = build_transfer(R.problem->grid, C.problem->grid);
       const index n = R.problem->dofs();
       load_guess.resize(n);
@@ -90,7 +96,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     // each iterate's body: E u from one S apply, plus K_ii^{-1} l_i
     newton.progress = [&, shown = newton.progress, step = 0](const NewtonProgress& pr) mutable {
       if (shown) shown(pr);
-      std::vector<real> Su(pr.u->size()), u_full(3 * size_t(S.problem().nodes()));
+      std::vector<real> Su(pr.u->size()), u_full(S.full_size());
       S.apply(pr.u->data(), Su.data(), 1e-8, u_full.data());
       axpy(index(u_full.size()), 1, R.interior_load.data(), u_full.data());
       opt.iterate_done(Iterate{R.problem.get(), step++, &pr, &u_full, &R.contact.gap});
@@ -160,7 +166,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.inner_iterations = cond.iterations + newton_inner + R.report.inner.iterations;
   R.fine_matvecs_total = R.nested_fine_matvecs + R.newton_fine_matvecs() + S.apply_work(cond.iterations) +
                          S.apply_work(R.report.inner.iterations);
-  R.peak_memory = peak_memory_bytes();
+  R.peak_memory = Comm::world().max(peak_memory_bytes());  // several ranks: the largest rank's
   // A failed Newton solve is redone another way, its work and time added
   // to the new run's. Both ways have no line search:
   // - one Coulomb Newton solve can oscillate for large F (lagged bound,

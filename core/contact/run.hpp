@@ -109,7 +109,7 @@ struct RunResult {
   // newton.fine_matvecs): the whole run, condensed load, Newton and the
   // final tight check (which includes the recovery)
   double fine_matvecs_total = 0;
-  double peak_memory = 0;  // bytes, process peak resident set after the run
+  double peak_memory = 0;  // bytes, process peak resident set after the run (several ranks: the largest)
   // the coarse meshes of nested iteration, coarsest first (empty: cold start);
   // fine_matvecs_total includes their work, scaled by their share of the dofs
   std::vector<NestedLevel> nested;

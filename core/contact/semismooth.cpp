@@ -232,13 +232,10 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
 }  // namespace
 
 std::vector<real> step_scale(const SteklovPoincare& S) {
-  const std::vector<real> kd = S.K().diagonal();
-  const index p = S.size() / 3, N = S.problem().nodes();
+  const std::vector<real> kd = S.contact_diagonal();
+  const index p = S.size() / 3;
   std::vector<real> s(p);
-  for (index c = 0; c < p; ++c) {
-    const index n = S.problem().contact_grid_node(c);
-    s[c] = (kd[n] + kd[N + n] + kd[2 * N + n]) / 3;
-  }
+  for (index c = 0; c < p; ++c) s[c] = (kd[c] + kd[p + c] + kd[2 * p + c]) / 3;
   return s;
 }
 
@@ -303,7 +300,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
       R.operator_applications += 1;
       real* ext = nullptr;
       if (opt.extension0) {
-        opt.extension0->resize(3 * S.problem().nodes());
+        opt.extension0->resize(S.full_size());
         ext = opt.extension0->data();
       }
       if (!work.apply(S, R.u.data(), R.Su.data(), std::max(opt.book_accuracy, real(1e-12)), ext, ext))
@@ -315,7 +312,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   ReducedSystem L(n3);
   std::unique_ptr<BoundaryPreconditioner> M;
   if (opt.outer_pc == OuterPreconditioner::multigrid)
-    M = std::make_unique<BoundaryPreconditioner>(S, S.interior_multigrid().options());
+    M = std::make_unique<BoundaryPreconditioner>(S, S.mg_options());
   CGWorkspace ws;
   const real* scale_ptr = scale.empty() ? nullptr : scale.data();
   real smax = 0;  // Coulomb Newton: bounds |S Δu| by smax |Δu| for the bookkeeping apply

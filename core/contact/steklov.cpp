@@ -1,56 +1,109 @@
 #include "core/contact/steklov.hpp"
 
+#include "core/parallel/distributed_elasticity.hpp"
+
 #include <stdexcept>
 #include <string>
 
 #include "kernels/vector_ops.hpp"
+#include "core/parallel/distributed_multigrid.hpp"
 #include "core/util/profile.hpp"
 
 namespace tresca {
 
-SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg)
-    : P_(P),
-      p_(P.contact_nodes()),
-      K_(P.grid, P.dirichlet_faces, P.spec.E, P.spec.nu),
-      mg_(GridHierarchy::build(P.grid, mg.coarse_nodes), elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mg) {
-  const index n = 3 * P.nodes();
+SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Comm& comm)
+    : P_(P), p_(P.contact_nodes()), comm_(comm), mg_opt_(mg) {
+  if (worth_distributing(P.grid, comm)) {
+    dmg_ = std::make_unique<DistributedMultigrid>(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mg, comm);
+    Kd_ = std::make_unique<DistributedElasticity>(dmg_->fine_slab(), P.dirichlet_faces, P.spec.E, P.spec.nu, comm);
+    // contact node c = (ix - 1) + ex iy: a rank's rows hold a contiguous range
+    const index ex = P.grid.ex;
+    c_begin_ = ex * dmg_->fine_slab().y_begin;
+    c_end_ = ex * dmg_->fine_slab().y_end;
+    counts_.resize(comm.size());
+    displs_.resize(comm.size());
+    for (int q = 0; q < comm.size(); ++q) {
+      const Slab s = make_slab(P.grid, q, comm.size());
+      counts_[q] = int(ex * s.owned_rows());
+      displs_[q] = int(ex * s.y_begin);
+    }
+  } else {
+    K_ = ElasticityOperator(P.grid, P.dirichlet_faces, P.spec.E, P.spec.nu);
+    mg_ = std::make_unique<Multigrid>(GridHierarchy::build(P.grid, mg.coarse_nodes),
+                                      elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mg);
+  }
+  const index n = full_size();
   w_.assign(n, 0);
   t_.assign(n, 0);
   z_.assign(n, 0);
 }
 
+SteklovPoincare::~SteklovPoincare() = default;
+
+index SteklovPoincare::full_size() const { return dmg_ ? 3 * dmg_->fine_slab().local.nodes() : 3 * P_.nodes(); }
+const Slab& SteklovPoincare::slab() const { return dmg_->fine_slab(); }
+const GridDims& SteklovPoincare::box() const { return dmg_ ? dmg_->fine_slab().local : P_.grid; }
+
 void SteklovPoincare::scatter(const real* vc, real* full) const {
-  const index N = P_.nodes();
-  for (index c = 0; c < p_; ++c) {
-    const index n = P_.contact_grid_node(c);
+  const GridDims& g = box();
+  const index N = g.nodes(), ex = P_.grid.ex;
+  const index c0 = dmg_ ? c_begin_ : 0, c1 = dmg_ ? c_end_ : p_, row0 = dmg_ ? slab().y_begin - slab().lo : 0;
+  for (index c = c0; c < c1; ++c) {
+    const index n = g.node(1 + c % ex, c / ex - row0, 0);
     for (int a = 0; a < 3; ++a) full[a * N + n] = vc[a * p_ + c];
   }
 }
 
 void SteklovPoincare::gather(const real* full, real* vc) const {
-  const index N = P_.nodes();
-  for (index c = 0; c < p_; ++c) {
-    const index n = P_.contact_grid_node(c);
+  const GridDims& g = box();
+  const index N = g.nodes(), ex = P_.grid.ex;
+  const index c0 = dmg_ ? c_begin_ : 0, c1 = dmg_ ? c_end_ : p_, row0 = dmg_ ? slab().y_begin - slab().lo : 0;
+  for (index c = c0; c < c1; ++c) {
+    const index n = g.node(1 + c % ex, c / ex - row0, 0);
     for (int a = 0; a < 3; ++a) vc[a * p_ + c] = full[a * N + n];
   }
+  if (dmg_)
+    for (int a = 0; a < 3; ++a) comm_.allgather(vc + a * p_, counts_, displs_);
+}
+
+std::vector<real> SteklovPoincare::contact_diagonal() const {
+  std::vector<real> d(full_size()), dc(3 * p_);
+  if (Kd_)
+    Kd_->diagonal(d.data());
+  else
+    d = K_.diagonal();
+  gather(d.data(), dc.data());
+  return dc;
+}
+
+void SteklovPoincare::apply_planes(const real* x, real* y, index z_begin, index z_end) const {
+  if (Kd_)
+    Kd_->apply_planes(x, y, z_begin, z_end);
+  else
+    K_.apply_planes(x, y, z_begin, z_end);
 }
 
 SolveStats SteklovPoincare::solve_interior(const real* rhs, real* z, real rtol, const real* guess) const {
   ScopedTimer t(Kernel::inner_cg);
   CGOptions o;
   o.rtol = rtol;
+  const unsigned faces = dmg_ ? slab().local_faces(P_.interior_faces) : P_.interior_faces;
   if (guess) {
-    copy(3 * P_.nodes(), guess, z);
-    zero_constrained(P_.grid, P_.interior_faces, z);  // the guess of an extension carries v on plane 0
+    copy(full_size(), guess, z);
+    zero_constrained(box(), faces, z);  // the guess of an extension carries v on plane 0
     o.zero_initial_guess = false;
   }
   o.max_iterations = 500;
-  return pcg(mg_.op(0), &mg_, rhs, z, o, ws_);
+  if (dmg_) {
+    o.comm = &comm_;
+    return pcg(dmg_->op(), dmg_.get(), rhs, z, o, ws_);
+  }
+  return pcg(mg_->op(0), mg_.get(), rhs, z, o, ws_);
 }
 
 void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
-  const GridDims& g = P_.grid;
-  const index plane = g.nx() * g.ny(), N = P_.nodes();
+  const GridDims& g = box();
+  const index plane = g.nx() * g.ny(), N = g.nodes();
   for (int a = 0; a < 3; ++a) {
     real* dst = v + a * N + iz * plane;
     if (src)
@@ -63,17 +116,17 @@ void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
 SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* extension, const real* guess) const {
   // Invariants between calls: w_ is zero off the contact nodes, t_ is zero
   // off plane 1, so only plane-sized work surrounds the inner solve.
-  const GridDims& g = P_.grid;
-  const index N = P_.nodes(), plane = g.nx() * g.ny();
+  const GridDims& g = box();
+  const index N = g.nodes(), plane = g.nx() * g.ny();
   scatter(v, w_.data());
   // t = -K_ic v lives on plane 1 (w_ is zero on the x = 0 nodes, so are t's)
-  K_.apply_planes(w_.data(), t_.data(), 1, 2);
+  apply_planes(w_.data(), t_.data(), 1, 2);
   for (int a = 0; a < 3; ++a) scale(plane, -1, t_.data() + a * N + plane);
   const SolveStats st = solve_interior(t_.data(), z_.data(), rtol, guess);
   // u = w + z: z vanishes on the constrained plane 0, where w lives
   set_plane(z_.data(), 0, w_.data());
   // Sv = (K u)_c on plane 0, then restore t_'s invariant
-  K_.apply_planes(z_.data(), t_.data(), 0, 1);
+  apply_planes(z_.data(), t_.data(), 0, 1);
   gather(t_.data(), Sv);
   set_plane(t_.data(), 0, nullptr);
   if (extension) copy(3 * N, z_.data(), extension);
@@ -81,20 +134,28 @@ SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* exte
 }
 
 double SteklovPoincare::apply_work(long long inner_iterations) const {
-  return double(inner_iterations) * (1 + mg_.cycle_work()) + 2.0 / double(P_.grid.nz());
+  const double cycle = dmg_ ? dmg_->cycle_work() : mg_->cycle_work();
+  return double(inner_iterations) * (1 + cycle) + 2.0 / double(P_.grid.nz());
 }
 
 SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior,
                                            const real* guess) const {
-  std::vector<real> li(P_.load);
-  zero_constrained(P_.grid, P_.interior_faces, li.data());
+  // the load on this rank's rows (all of it on one rank)
+  std::vector<real> load(P_.load);
+  if (dmg_) {
+    load.assign(full_size(), 0);
+    global_to_local(slab(), P_.load.data(), load.data());
+  }
+  std::vector<real> li(load);
+  zero_constrained(box(), dmg_ ? slab().local_faces(P_.interior_faces) : P_.interior_faces, li.data());
+  if (dmg_) Kd_->zero_ghosts(li.data());
   const SolveStats st = solve_interior(li.data(), z_.data(), rtol, guess);
-  K_.apply_planes(z_.data(), t_.data(), 0, 1);
+  apply_planes(z_.data(), t_.data(), 0, 1);
   std::vector<real> lc(3 * p_);
   b.resize(3 * p_);
   gather(t_.data(), b.data());
   set_plane(t_.data(), 0, nullptr);
-  gather(P_.load.data(), lc.data());
+  gather(load.data(), lc.data());
   for (index i = 0; i < 3 * p_; ++i) b[i] = lc[i] - b[i];
   if (interior) interior->assign(z_.begin(), z_.end());
   return st;

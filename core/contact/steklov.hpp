@@ -15,6 +15,15 @@
 // [u_x(0..p-1) | u_y | u_z], contact node c as in problem.hpp.
 // Cost per apply: one inner MG-CG solve (dominant) + 2 plane applies.
 //
+// Ranks (core/parallel): when the run has several MPI ranks and the grid is
+// worth splitting (worth_distributing), the 3D vectors are y-slab local
+// vectors (slab.hpp; full_size() entries), K and the K_ii multigrid are
+// distributed, and the contact vectors stay whole on every rank: each rank
+// scatters its own contact nodes into its slab, and gather collects every
+// rank's nodes on all ranks (MPI_Allgatherv of 3p values per apply, small
+// against the inner solve). The Newton iteration then runs unchanged and
+// identically on every rank. One rank: the threaded code, bit for bit.
+//
 // State: the operator is immutable after construction. Every call takes the
 // inner solve's relative tolerance and returns that solve's SolveStats (the
 // caller counts its own work); the full-size work vectors are scratch only
@@ -22,16 +31,34 @@
 #pragma once
 #include <vector>
 
+#include <memory>
+
 #include "core/solvers/cg.hpp"
 #include "core/solvers/multigrid.hpp"
 #include "core/fem/problem.hpp"
+#include "core/parallel/comm.hpp"
 
 namespace tresca {
 
+class DistributedElasticity;
+class DistributedMultigrid;
+struct Slab;
+
 class SteklovPoincare {
  public:
-  SteklovPoincare(const Problem& P, const MGOptions& mg = {});
+  SteklovPoincare(const Problem& P, const MGOptions& mg = {}, const Comm& comm = Comm::world());
+  ~SteklovPoincare();
   index size() const { return 3 * p_; }
+  // entries of a 3D vector (extension, guess, interior): 3N, or 3 x the
+  // rank's slab nodes when distributed
+  index full_size() const;
+  bool distributed() const { return bool(dmg_); }
+  const Slab& slab() const;  // distributed only
+  const DistributedMultigrid& distributed_multigrid() const { return *dmg_; }  // distributed only
+  const Comm& comm() const { return comm_; }
+  const MGOptions& mg_options() const { return mg_opt_; }
+  // diag(K) at the contact nodes, 3 blocks of p (K clamped on x = 0 only)
+  std::vector<real> contact_diagonal() const;
   // Sv = S v with the inner K_ii solve to relative tolerance rtol (of the
   // solve's right-hand side, so a good initial guess means fewer iterations,
   // not a looser answer); with `extension`, also E v there (3N SoA: v on the
@@ -46,15 +73,16 @@ class SteklovPoincare {
   SolveStats condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior = nullptr,
                             const real* guess = nullptr) const;
 
-  const Multigrid& interior_multigrid() const { return mg_; }  // its options() also serve the Newton step
+  const Multigrid& interior_multigrid() const { return *mg_; }  // one rank only
   // work of one apply in fine-grid matvec equivalents, given the inner CG
   // iterations it took: each iteration one K_ii apply and one V-cycle, plus
   // the two plane applies around the solve
   double apply_work(long long inner_iterations) const;
-  const ElasticityOperator& K() const { return K_; }
   const Problem& problem() const { return P_; }
 
   // scatter contact values into / gather them from a full SoA grid vector
+  // (distributed: scatter writes this rank's contact nodes into its slab,
+  // gather returns every rank's on all ranks)
   void scatter(const real* vc, real* full) const;
   void gather(const real* full, real* vc) const;
 
@@ -62,11 +90,21 @@ class SteklovPoincare {
   SolveStats solve_interior(const real* rhs, real* z, real rtol, const real* guess = nullptr) const;
   // plane iz of all 3 components of v := src's (or 0 if src is null)
   void set_plane(real* v, index iz, const real* src) const;
+  void apply_planes(const real* x, real* y, index z_begin, index z_end) const;
+  const GridDims& box() const;  // the grid of the 3D vectors
 
   const Problem& P_;
   index p_;
+  const Comm& comm_;
+  MGOptions mg_opt_;
+  // one rank
   ElasticityOperator K_;       // faces x0
-  Multigrid mg_;               // K_ii hierarchy, faces x0 | z0
+  std::unique_ptr<Multigrid> mg_;  // K_ii hierarchy, faces x0 | z0
+  // several ranks (empty otherwise)
+  std::unique_ptr<DistributedElasticity> Kd_;  // faces x0
+  std::unique_ptr<DistributedMultigrid> dmg_;  // K_ii, faces x0 | z0
+  index c_begin_ = 0, c_end_ = 0;              // this rank's contact nodes
+  std::vector<int> counts_, displs_;           // every rank's contact nodes (allgather)
   mutable CGWorkspace ws_;  // scratch
   mutable std::vector<real> w_, t_, z_;
 };

@@ -214,9 +214,8 @@ void require_one_rank(const char* program) {
   if (!rank) rank = std::getenv("PMI_RANK");
   if (!rank || std::string(rank) == "0")
     std::fprintf(stderr,
-                 "%s: started as %d MPI ranks, but %s runs on one rank (its distributed version is issue 12's "
-                 "work in progress; build/bin/mpi_apply is distributed). Run it as one process, threads with "
-                 "OMP_NUM_THREADS or --threads.\n",
+                 "%s: started as %d MPI ranks, but %s runs on one rank (tresca, elastic and mpi_apply "
+                 "are distributed). Run it as one process, threads with OMP_NUM_THREADS or --threads.\n",
                  program, ranks, program);
   std::exit(2);
 }

@@ -47,9 +47,9 @@ void check_memory(const ProblemSpec& s);
 //   1.7 -> 0.7 s, the whole run 13.6 -> 9.9 s (perf/RESULTS.md §0d).
 void default_runtime_environment(char** argv);
 // Exits with status 2 and a message (from the first rank) when mpirun
-// started this program as several ranks: the solver drivers are not
-// distributed yet (issue 12; perf/mpi_apply is), and N copies of one solve
-// would each write the same outputs.
+// started this program as several ranks: for the drivers that are not
+// distributed (scaling, mg_scaling, roofline), whose N copies would each
+// run and write the same thing.
 void require_one_rank(const char* program);
 // --threads N (else OMP_NUM_THREADS / all cores); returns the thread count in use
 int apply_threads(const Args& a);

@@ -1,5 +1,7 @@
 #include "core/io/summary.hpp"
 
+#include "core/parallel/comm.hpp"
+
 #include <cmath>
 
 #include "core/io/output.hpp"
@@ -59,7 +61,8 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["obstacle"] = obstacle;
   j["load_scale"] = spec.load_scale;
   j["eps"] = eps;
-  j["threads"] = threads;
+  j["threads"] = threads;  // per rank
+  j["ranks"] = Comm::world().size();
   j["build"] = build_info();
   j["mg_precision"] = to_string(opt.mg.precision);
   j["newton_iterations"] = N.iterations;

@@ -78,6 +78,17 @@ double Comm::max(double local) const {
   return local;
 }
 
+void Comm::allgather(real* v, const std::vector<int>& counts, const std::vector<int>& displs) const {
+#ifdef TRESCA_HAVE_MPI
+  if (size_ > 1)
+    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, v, counts.data(), displs.data(), MPI_DOUBLE, MPI_COMM_WORLD);
+#else
+  (void)v;
+  (void)counts;
+  (void)displs;
+#endif
+}
+
 void Comm::barrier() const {
 #ifdef TRESCA_HAVE_MPI
   if (size_ > 1) MPI_Barrier(MPI_COMM_WORLD);

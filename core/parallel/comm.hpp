@@ -24,6 +24,8 @@ class Comm {
   real sum(real local) const;
   void sum(real* values, int n) const;  // in place, element by element
   double max(double local) const;
+  // in place: rank q's part v[displs[q] .. displs[q] + counts[q]) to every rank
+  void allgather(real* v, const std::vector<int>& counts, const std::vector<int>& displs) const;
   void barrier() const;
 
  private:

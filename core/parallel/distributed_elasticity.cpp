@@ -164,6 +164,13 @@ void DistributedElasticity::apply_impl(const T* x, T* y, const T* b) const {
   zero_ghosts(y);
 }
 
+void DistributedElasticity::apply_planes(const real* x, real* y, index z_begin, index z_end) const {
+  exchange(const_cast<real*>(x));  // ghost rows only (header)
+  const GridDims& g = slab_.local;
+  ScopedTimer t(Kernel::apply, double(g.nx() * slab_.owned_rows() * (z_end - z_begin)) * kApplyCost);
+  elasticity_apply(k_, x, y, RowBlock{z_begin, z_end, slab_.lo, slab_.lo + slab_.owned_rows()});
+}
+
 template <class T>
 void DistributedElasticity::zero_ghosts(T* v) const {
   if (slab_.lo) fill_row(slab_.local, T(0), 0, v);

@@ -47,6 +47,9 @@ class DistributedElasticity : public LinearOperator {
   // floats): the multigrid V-cycle's (distributed_multigrid.hpp)
   void apply(const float* x, float* y) const;
   void residual(const float* b, const float* x, float* r) const;
+  // y = K x on output planes [z_begin, z_end) of the owned rows only, after
+  // a (blocking) exchange of x's ghost rows; other entries of y untouched
+  void apply_planes(const real* x, real* y, index z_begin, index z_end) const;
   // ghost rows of x := the neighbours' owned rows (blocking)
   void exchange(real* x) const;
   // diag(K) on the owned rows (1 on constrained dofs), 0 on the ghost rows

@@ -74,6 +74,11 @@ void row_range(const Slab& s, index& first, index& last) {
 
 }  // namespace
 
+bool worth_distributing(const GridDims& g, const Comm& comm, index min_nodes_per_rank) {
+  const int P = comm.size();
+  return P > 1 && g.ny() >= 2 * P && g.nodes() / P >= min_nodes_per_rank;
+}
+
 DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt,
                                            const Comm& comm, index min_nodes_per_rank, const DistributedMultigrid* like)
     : opt_(opt), comm_(comm), faces_(faces), grids_(GridHierarchy::build(fine, opt.coarse_nodes)) {
@@ -83,7 +88,7 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
     auto lv = std::make_unique<Level>();
     lv->g = g;
     const bool coarsest = levels_.size() + 1 == grids_->grids.size();  // solved by a factorisation on each rank
-    replicated = replicated || coarsest || g.ny() < 2 * P || g.nodes() / P < min_nodes_per_rank;
+    replicated = replicated || coarsest || !worth_distributing(g, comm, min_nodes_per_rank);
     lv->distributed = !replicated;
     if (lv->distributed) {
       lv->slab = make_slab(g, comm.rank(), P);

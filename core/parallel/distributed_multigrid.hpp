@@ -35,6 +35,11 @@
 
 namespace tresca {
 
+// whether a grid is split over the ranks (a DistributedMultigrid's level 0
+// is then distributed): more than one rank, at least 2 node rows and
+// min_nodes_per_rank nodes per rank
+bool worth_distributing(const GridDims& g, const Comm& comm, index min_nodes_per_rank = 2048);
+
 class DistributedMultigrid : public LinearOperator {
  public:
   // like: take the smoother bounds from that multigrid (same grid, options
