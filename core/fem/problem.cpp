@@ -195,4 +195,9 @@ double estimated_memory_bytes(const ProblemSpec& s) {
   return 24.0 * 3 * n * 8 * (1 + 1.0 / 7);
 }
 
+double estimated_memory_bytes_per_rank(const ProblemSpec& s, int ranks) {
+  if (ranks <= 1) return estimated_memory_bytes(s);
+  return estimated_memory_bytes(s) / ranks + 2 * 3 * double(s.nodes()) * 8;
+}
+
 }  // namespace tresca

@@ -185,13 +185,22 @@ std::pair<double, std::string> memory_limit() {
 }  // namespace
 
 void check_memory(const ProblemSpec& s) {
-  const double need = estimated_memory_bytes(s);
+  // several ranks: the ranks on each machine share its memory; any machine
+  // short of it fails the check on every rank (the same message, no hang)
+  const Comm& comm = Comm::world();
+  const int on_host = comm.ranks_on_this_host();
+  const double per_rank = estimated_memory_bytes_per_rank(s, comm.size()), need = per_rank * on_host;
   const auto [have, whose] = memory_limit();
-  if (have > 0 && need > 0.9 * have) {
+  const bool short_here = have > 0 && need > 0.9 * have;
+  if (comm.max(short_here ? 1.0 : 0.0) > 0) {
     std::ostringstream os;
     if (s.level >= 0) os << "level " << s.level << " (";
-    os << "mesh " << dims_string(s) << (s.level >= 0 ? ")" : "") << " needs about " << need / 1e9 << " GB, more than "
-       << whose << " " << have / 1e9 << " GB";
+    os << "mesh " << dims_string(s) << (s.level >= 0 ? ")" : "") << " needs about ";
+    if (comm.distributed())
+      os << per_rank / 1e9 << " GB per rank on " << comm.size() << " ranks, " << need / 1e9 << " GB for the " << on_host
+         << " ranks of one machine, more than " << whose << " " << have / 1e9 << " GB";
+    else
+      os << need / 1e9 << " GB, more than " << whose << " " << have / 1e9 << " GB";
     fail(os.str());
   }
 }

@@ -89,6 +89,20 @@ void Comm::allgather(real* v, const std::vector<int>& counts, const std::vector<
 #endif
 }
 
+int Comm::ranks_on_this_host() const {
+#ifdef TRESCA_HAVE_MPI
+  if (size_ > 1) {
+    MPI_Comm host;
+    MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &host);
+    int n = 1;
+    MPI_Comm_size(host, &n);
+    MPI_Comm_free(&host);
+    return n;
+  }
+#endif
+  return 1;
+}
+
 void Comm::barrier() const {
 #ifdef TRESCA_HAVE_MPI
   if (size_ > 1) MPI_Barrier(MPI_COMM_WORLD);
