@@ -191,14 +191,19 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, std::string>> outputs;  // (path, what)
     if (!json_path.empty()) outputs.push_back({json_path, "--json"});
     if (!csv_path.empty()) outputs.push_back({csv_path, "--contact-csv"});
-    if (!vtk_path.empty() && table.empty()) {
+    if (!vtk_path.empty() && table.empty() && !comm.distributed()) {
       outputs.push_back({vtk_path, "--vtk"});
       outputs.push_back({vtu_companion(vtk_path), "--vtk's contact file"});
     }
-    if (!vtk_path.empty() && comm.distributed())
-      throw std::invalid_argument("--vtk with " + std::to_string(comm.size()) +
-                                  " MPI ranks: the distributed VTU output (.pvtu) is not written yet; run --vtk on one rank");
+    if (!vtk_path.empty() && table.empty() && comm.distributed()) {  // ParaView's parallel format
+      outputs.push_back({path_stem(vtk_path) + ".pvtu", "--vtk's index"});
+      outputs.push_back({pvtu_piece_name(vtk_path, comm.rank()), "--vtk's piece"});
+      outputs.push_back({vtu_companion(vtk_path), "--vtk's contact file"});
+    }
     every_iteration = a.has("--vtk-every-iteration");
+    if (!vtk_path.empty() && comm.distributed() && (!table.empty() || every_iteration))
+      throw std::invalid_argument("--vtk with --table or --vtk-every-iteration on " + std::to_string(comm.size()) +
+                                  " MPI ranks: not written yet (one run's .pvtu is); run it on one rank");
     if (every_iteration && (vtk_path.empty() || !table.empty()))
       throw std::invalid_argument("--vtk-every-iteration needs --vtk FILE.vtu (and no --table)");
     if (every_iteration) {
@@ -224,7 +229,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());
     return 2;
   }
-  if (comm.rank() != 0) json_path = csv_path = "";  // outputs: rank 0's
+  if (comm.rank() != 0) json_path = csv_path = "";  // outputs: rank 0's (and a piece of the VTU each)
 
   if (opt.newton.scaling == StepScaling::paper && (spec.E < 1e6 || spec.E > 1e12))
     std::fprintf(stderr,
@@ -399,10 +404,18 @@ int main(int argc, char** argv) {
       if (every_iteration) write_pvd(out, pvd_name(vtk_path), steps);
       if (!json_path.empty()) write_text(out, json_path, json_text(run_summary(spec, R, threads, opt)));
       if (!csv_path.empty()) write_contact_csv(out, csv_path, *R.problem, cf);
-      std::string second;
-      if (!vtk_path.empty()) second = write_vtu(out, vtk_path, *R.problem, R.u_full, cf, vtk_format);
+      std::string first = vtk_path, second;
+      if (!vtk_path.empty() && comm.distributed()) {
+        second = write_pvtu(out, vtk_path, *R.problem, R.slab, R.u_full, cf, vtk_format);
+        first = path_stem(vtk_path) + ".pvtu (with " + std::to_string(comm.size()) + " pieces " +
+                pvtu_piece_name(vtk_path, 0) + ", ...)";
+        out.finish();
+        comm.barrier();  // every rank's piece complete on disk before any is published
+      } else if (!vtk_path.empty()) {
+        second = write_vtu(out, vtk_path, *R.problem, R.u_full, cf, vtk_format);
+      }
       out.publish();
-      if (!vtk_path.empty() && !quiet) std::printf("wrote %s and %s\n", vtk_path.c_str(), second.c_str());
+      if (!vtk_path.empty() && !quiet) std::printf("wrote %s and %s\n", first.c_str(), second.c_str());
     } catch (const std::exception& e) {
       std::fprintf(stderr, "tresca: error: %s\n", e.what());
       return 3;

@@ -5,6 +5,7 @@ Debian python3-vtk9) and checks them against the run's contact CSV and JSON:
   check_vtu.py --vtu B.vtu --csv C.csv --json J.json [--ascii A.vtu --min-ratio R]
   check_vtu.py --pvd P.pvd --steps N
   check_vtu.py --pvd P.pvd --json J.json      (a --vtk-every-iteration run)
+  check_vtu.py --pvtu P.pvtu --vtu B.vtu --rtol R   (several ranks against one)
 
 - the body: (ex+1)(ey+1)(ez+1) points, ex*ey*ez hexahedra of positive volume
   (every cell is checked in vectorised form), its bottom plane's displacement
@@ -15,7 +16,12 @@ Debian python3-vtk9) and checks them against the run's contact CSV and JSON:
 - --ascii: the same run written as text holds the same arrays (to its 12
   digits), and the binary files are at least R times smaller;
 - --pvd: a collection of N steps, the body and its contact face each, all
-  files read by VTK.
+  files read by VTK;
+- --pvtu: ParaView's parallel file of a run on several ranks, read whole by
+  VTK's parallel reader: as many hexahedra as the one-rank file B.vtu, each
+  point's displacement, contact force and status equal to B's at the same
+  coordinates (displacements within R of the largest), and the contact
+  files of both runs equal to R.
 Exits 1 with the first failed check on stderr."""
 import argparse
 import csv
@@ -135,6 +141,42 @@ def check_pvd(args):
     print("%s: %d steps of 2 parts each, all read by VTK" % (args.pvd, len(steps)))
 
 
+def check_pvtu(args):
+    r = vtk.vtkXMLPUnstructuredGridReader()
+    r.SetFileName(args.pvtu)
+    r.Update()
+    g = r.GetOutput()
+    if r.GetErrorCode() != 0 or g is None or g.GetNumberOfPoints() == 0:
+        fail(args.pvtu + ": VTK's parallel reader could not read it")
+    one = read(args.vtu)
+    a, b = arrays(g), arrays(one)
+    if g.GetNumberOfCells() != one.GetNumberOfCells():
+        fail("%d cells in the pieces, %d in %s" % (g.GetNumberOfCells(), one.GetNumberOfCells(), args.vtu))
+    # the pieces repeat the rows between them: match points by coordinates
+    key = lambda pts: [tuple(np.round(x, 9)) for x in pts]
+    index_b = {k: i for i, k in enumerate(key(b["points"]))}
+    rows = np.array([index_b.get(k, -1) for k in key(a["points"])])
+    if (rows < 0).any():
+        fail("%d points of the pieces are not points of %s" % (int((rows < 0).sum()), args.vtu))
+    if len(set(rows.tolist())) != one.GetNumberOfPoints():
+        fail("the pieces do not cover every point of " + args.vtu)
+    scale = np.abs(b["displacement"]).max()
+    d = np.abs(a["displacement"] - b["displacement"][rows]).max() / scale
+    fscale = max(np.abs(b["contact_force"]).max(), 1e-300)
+    df = np.abs(a["contact_force"] - b["contact_force"][rows]).max() / fscale
+    if d > args.rtol or df > args.rtol:
+        fail("displacement differs by %.3e, contact force by %.3e of their largest (tolerance %g)" % (d, df, args.rtol))
+    if (a["contact_status"] != b["contact_status"][rows]).any():
+        fail("contact_status differs")
+    ca, cb = arrays(read(companion(args.pvtu))), arrays(read(companion(args.vtu)))
+    dc = np.abs(ca["displacement"] - cb["displacement"]).max() / max(np.abs(cb["displacement"]).max(), 1e-300)
+    if dc > args.rtol or (ca["contact_status"] != cb["contact_status"]).any():
+        fail("the contact files differ (displacement by %.3e)" % dc)
+    print("%s: %d pieces, %d points (%d shared), %d cells; displacement within %.2e, contact force within %.2e of %s"
+          % (args.pvtu, r.GetNumberOfPieces(), g.GetNumberOfPoints(), g.GetNumberOfPoints() - one.GetNumberOfPoints(),
+             g.GetNumberOfCells(), d, df, args.vtu))
+
+
 p = argparse.ArgumentParser()
 p.add_argument("--vtu")
 p.add_argument("--csv")
@@ -143,8 +185,12 @@ p.add_argument("--ascii")
 p.add_argument("--min-ratio", type=float, default=5)
 p.add_argument("--pvd")
 p.add_argument("--steps", type=int)
+p.add_argument("--pvtu")
+p.add_argument("--rtol", type=float, default=1e-10)
 a = p.parse_args()
-if a.pvd:
+if a.pvtu:
+    check_pvtu(a)
+elif a.pvd:
     check_pvd(a)
 else:
     check_run(a)

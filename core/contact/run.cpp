@@ -148,9 +148,11 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   // gives E u: u = E u + K_ii^{-1} l_i
   const bool warm = !extension.empty();
   R.report = final_report(S, btilde, R.contact, R.newton, opt.tight_rtol, &extension, warm);
+  R.slab = S.distributed() ? S.slab() : make_slab(R.problem->grid, 0, 1);
   if (opt.recover_interior) {
     R.u_full = std::move(extension);
     axpy(index(R.u_full.size()), 1, R.interior_load.data(), R.u_full.data());
+    S.exchange_ghosts(R.u_full.data());  // its ghost rows too (output pieces)
   } else {
     R.interior_load = {};
   }

@@ -12,6 +12,7 @@
 #include "core/contact/coulomb.hpp"
 #include "core/contact/report.hpp"
 #include "core/contact/semismooth.hpp"
+#include "core/parallel/slab.hpp"
 
 namespace tresca {
 
@@ -102,7 +103,8 @@ struct RunResult {
     return !newton.converged() || !coulomb ? to_string(newton.reason) : to_string(coulomb_loop.reason);
   }
   FinalReport report;
-  std::vector<real> u_full;         // 3N SoA (empty if not recovered)
+  std::vector<real> u_full;         // 3N SoA (empty if not recovered); several ranks: slab's local vector
+  Slab slab;                        // the rank's rows of u_full (one rank: the whole grid)
   std::vector<real> interior_load;  // K_ii^{-1} l_i, 3N SoA (kept with u_full, for nested iteration)
   long long inner_iterations = 0;  // over the whole run, including condensation and the final check
   // work in fine-grid matvec equivalents (the Newton phase alone is

@@ -42,6 +42,10 @@ SteklovPoincare::~SteklovPoincare() = default;
 
 index SteklovPoincare::full_size() const { return dmg_ ? 3 * dmg_->fine_slab().local.nodes() : 3 * P_.nodes(); }
 const Slab& SteklovPoincare::slab() const { return dmg_->fine_slab(); }
+void SteklovPoincare::exchange_ghosts(real* full) const {
+  if (Kd_) Kd_->exchange(full);
+}
+
 const GridDims& SteklovPoincare::box() const { return dmg_ ? dmg_->fine_slab().local : P_.grid; }
 
 void SteklovPoincare::scatter(const real* vc, real* full) const {

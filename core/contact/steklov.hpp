@@ -54,6 +54,8 @@ class SteklovPoincare {
   index full_size() const;
   bool distributed() const { return bool(dmg_); }
   const Slab& slab() const;  // distributed only
+  // the ghost rows of a 3D vector := the neighbours' values (distributed; else nothing)
+  void exchange_ghosts(real* full) const;
   const DistributedMultigrid& distributed_multigrid() const { return *dmg_; }  // distributed only
   const Comm& comm() const { return comm_; }
   const MGOptions& mg_options() const { return mg_opt_; }

@@ -173,74 +173,120 @@ int status_code(std::uint8_t s) { return (s & kContact) ? ((s & kStick) ? 2 : 3)
 
 }  // namespace
 
-std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
-                      const ContactFields& c, VtkFormat format) {
+namespace {
+
+// the per-node contact id of the bottom plane (-1: not a contact node)
+std::vector<index> contact_ids(const Problem& P) {
   const GridDims& g = P.grid;
-  const index N = g.nodes(), p = P.contact_nodes(), M = g.nx() * g.ny();
-  std::vector<index> cid(M, -1);  // per node of the bottom plane: contact node id or -1
-  for (index i = 0; i < p; ++i) cid[P.contact_grid_node(i)] = i;
-  // interleaved xyz of `count` nodes of the grid's numbering, from SoA u_full
-  auto interleaved = [&](index count) {
-    std::vector<double> v(3 * size_t(count));
-    for (index n = 0; n < count; ++n)
-      for (int a = 0; a < 3; ++a) v[3 * n + a] = u_full[a * N + n];
-    return v;
-  };
-  {
-    std::vector<double> xyz(3 * size_t(N));
-    for (index iz = 0, n = 0; iz < g.nz(); ++iz)
-      for (index iy = 0; iy < g.ny(); ++iy)
-        for (index ix = 0; ix < g.nx(); ++ix, ++n) {
-          xyz[3 * n] = g.x0 + ix * g.hx();
-          xyz[3 * n + 1] = g.y0 + iy * g.hy();
-          xyz[3 * n + 2] = g.z0 + iz * g.hz();
-        }
-    std::vector<index> conn;
-    conn.reserve(size_t(8 * g.ex * g.ey * g.ez));
-    const int order[8] = {0, 1, 3, 2, 4, 5, 7, 6};  // VTK_HEXAHEDRON node order
-    for (index ez = 0; ez < g.ez; ++ez)
-      for (index ey = 0; ey < g.ey; ++ey)
-        for (index ex = 0; ex < g.ex; ++ex)
-          for (int k : order) conn.push_back(g.node(ex + (k & 1), ey + ((k >> 1) & 1), ez + ((k >> 2) & 1)));
-    Piece body(xyz, conn, 8, 12);
-    std::vector<double> force(3 * size_t(N), 0.0);
-    std::vector<std::uint8_t> code(N, 0);
-    for (index n = 0; n < M; ++n)
-      if (const index i = cid[n]; i >= 0) {
-        force[3 * n] = (*c.r)[i];
-        force[3 * n + 1] = (*c.r)[p + i];
-        force[3 * n + 2] = (*c.lambda)[i];
-        code[n] = std::uint8_t(status_code((*c.status)[i]));
+  std::vector<index> cid(g.nx() * g.ny(), -1);
+  for (index i = 0; i < P.contact_nodes(); ++i) cid[P.contact_grid_node(i)] = i;
+  return cid;
+}
+
+// The body's hexahedra between global node rows [r0, r1) (all of x and z),
+// displacement from the SoA vector u on grid ub, whose row 0 is global row rb.
+void write_body(OutputSet& out, const std::string& path, const Problem& P, index r0, index r1, const real* u,
+                const GridDims& ub, index rb, const ContactFields& c, VtkFormat format) {
+  const GridDims& g = P.grid;
+  const index p = P.contact_nodes(), nx = g.nx(), rows = r1 - r0, n_pts = nx * rows * g.nz(), Nu = ub.nodes();
+  const std::vector<index> cid = contact_ids(P);
+  auto local = [&](index ix, index iy, index iz) { return ix + nx * ((iy - r0) + rows * iz); };
+  std::vector<double> xyz(3 * size_t(n_pts)), disp(3 * size_t(n_pts)), force(3 * size_t(n_pts), 0.0);
+  std::vector<std::uint8_t> code(n_pts, 0);
+  for (index iz = 0; iz < g.nz(); ++iz)
+    for (index iy = r0; iy < r1; ++iy)
+      for (index ix = 0; ix < nx; ++ix) {
+        const index n = local(ix, iy, iz), m = ub.node(ix, iy - rb, iz);
+        xyz[3 * n] = g.x0 + ix * g.hx();
+        xyz[3 * n + 1] = g.y0 + iy * g.hy();
+        xyz[3 * n + 2] = g.z0 + iz * g.hz();
+        for (int a = 0; a < 3; ++a) disp[3 * n + a] = u[a * Nu + m];
+        if (iz == 0)
+          if (const index i = cid[ix + nx * iy]; i >= 0) {
+            force[3 * n] = (*c.r)[i];
+            force[3 * n + 1] = (*c.r)[p + i];
+            force[3 * n + 2] = (*c.lambda)[i];
+            code[n] = std::uint8_t(status_code((*c.status)[i]));
+          }
       }
-    body.point_data.emplace_back(Array::Type::f64, "displacement", 3, interleaved(N));
-    body.point_data.emplace_back(Array::Type::f64, "contact_force", 3, force);
-    body.point_data.emplace_back(Array::Type::u8, "contact_status", 1, code);
-    body.write(out.create(path), format);
-  }
-  // contact face: the bottom plane as quads, its own point numbering
-  std::vector<double> xyz(3 * size_t(M));
+  std::vector<index> conn;
+  conn.reserve(size_t(8 * g.ex * (rows - 1) * g.ez));
+  const int order[8] = {0, 1, 3, 2, 4, 5, 7, 6};  // VTK_HEXAHEDRON node order
+  for (index ez = 0; ez < g.ez; ++ez)
+    for (index ey = r0; ey + 1 < r1; ++ey)
+      for (index ex = 0; ex < g.ex; ++ex)
+        for (int k : order) conn.push_back(local(ex + (k & 1), ey + ((k >> 1) & 1), ez + ((k >> 2) & 1)));
+  Piece body(xyz, conn, 8, 12);
+  body.point_data.emplace_back(Array::Type::f64, "displacement", 3, disp);
+  body.point_data.emplace_back(Array::Type::f64, "contact_force", 3, force);
+  body.point_data.emplace_back(Array::Type::u8, "contact_status", 1, code);
+  body.write(out.create(path), format);
+}
+
+// The contact face (the bottom plane as quads, its own point numbering),
+// from the contact vectors: u there is u_c, and 0 on the clamped x = 0 nodes.
+void write_face(OutputSet& out, const std::string& path, const Problem& P, const ContactFields& c, VtkFormat format) {
+  const GridDims& g = P.grid;
+  const index M = g.nx() * g.ny(), p = P.contact_nodes();
+  const std::vector<index> cid = contact_ids(P);
+  std::vector<double> xyz(3 * size_t(M)), disp(3 * size_t(M), 0.0), lambda(M, 0.0);
+  std::vector<std::uint8_t> code(M, 0);
   for (index n = 0; n < M; ++n) {
     xyz[3 * n] = g.x0 + (n % g.nx()) * g.hx();
     xyz[3 * n + 1] = g.y0 + (n / g.nx()) * g.hy();
     xyz[3 * n + 2] = g.z0;
+    if (const index i = cid[n]; i >= 0) {
+      for (int a = 0; a < 3; ++a) disp[3 * n + a] = (*c.u)[a * p + i];
+      lambda[n] = (*c.lambda)[i];
+      code[n] = std::uint8_t(status_code((*c.status)[i]));
+    }
   }
   std::vector<index> conn;
   for (index ey = 0; ey < g.ey; ++ey)
     for (index ex = 0; ex < g.ex; ++ex)
       for (index k : {index(0), index(1), g.nx() + 1, g.nx()}) conn.push_back(ex + g.nx() * ey + k);
   Piece face(xyz, conn, 4, 9);
-  std::vector<double> lambda(M, 0.0);
-  std::vector<std::uint8_t> code(M, 0);
-  for (index n = 0; n < M; ++n)
-    if (cid[n] >= 0) {
-      lambda[n] = (*c.lambda)[cid[n]];
-      code[n] = std::uint8_t(status_code((*c.status)[cid[n]]));
-    }
-  face.point_data.emplace_back(Array::Type::f64, "displacement", 3, interleaved(M));
+  face.point_data.emplace_back(Array::Type::f64, "displacement", 3, disp);
   face.point_data.emplace_back(Array::Type::f64, "lambda", 1, lambda);
   face.point_data.emplace_back(Array::Type::u8, "contact_status", 1, code);
+  face.write(out.create(path), format);
+}
+
+}  // namespace
+
+std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
+                      const ContactFields& c, VtkFormat format) {
+  write_body(out, path, P, 0, P.grid.ny(), u_full.data(), P.grid, 0, c, format);
   const std::string cpath = vtu_companion(path);
-  face.write(out.create(cpath), format);
+  write_face(out, cpath, P, c, format);
+  return cpath;
+}
+
+std::string pvtu_piece_name(const std::string& path, int rank) {
+  return path_stem(path) + "_p" + std::to_string(rank) + ".vtu";
+}
+
+std::string write_pvtu(OutputSet& out, const std::string& path, const Problem& P, const Slab& s,
+                       const std::vector<real>& u_local, const ContactFields& c, VtkFormat format) {
+  // this rank's rows and the ghost row above: the cells between two slabs are the lower one's
+  write_body(out, pvtu_piece_name(path, s.rank), P, s.y_begin, s.y_end + s.hi, u_local.data(), s.local,
+             s.y_begin - s.lo, c, format);
+  if (s.rank != 0) return "";
+  std::string x =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\">\n<PUnstructuredGrid GhostLevel=\"0\">\n<PPointData Vectors=\"displacement\">\n"
+      "<PDataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\"/>\n"
+      "<PDataArray type=\"Float64\" Name=\"contact_force\" NumberOfComponents=\"3\"/>\n"
+      "<PDataArray type=\"UInt8\" Name=\"contact_status\" NumberOfComponents=\"1\"/>\n</PPointData>\n"
+      "<PPoints>\n<PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n</PPoints>\n";
+  for (int q = 0; q < s.ranks; ++q) {
+    std::string f = pvtu_piece_name(path, q);
+    if (const auto slash = f.find_last_of('/'); slash != std::string::npos) f = f.substr(slash + 1);
+    x += "<Piece Source=\"" + xml_escaped(f) + "\"/>\n";
+  }
+  write_text(out, path_stem(path) + ".pvtu", x + "</PUnstructuredGrid>\n</VTKFile>\n");
+  const std::string cpath = vtu_companion(path);
+  write_face(out, cpath, P, c, format);
   return cpath;
 }
 

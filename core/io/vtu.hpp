@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/io/output.hpp"
+#include "core/parallel/slab.hpp"
 
 namespace tresca {
 
@@ -28,6 +29,16 @@ VtkFormat parse_vtk_format(const std::string& s, const std::string& option);
 // vtu_companion(path). Returns the second file's path.
 std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
                       const ContactFields& c, VtkFormat format = VtkFormat::binary);
+
+// Several ranks (ParaView's parallel format): every rank writes its rows of
+// the body (and the ghost row above, so the pieces share the rows between
+// them) to "<stem>_p<rank>.vtu" from its slab vector u_local (slab.hpp, its
+// ghost rows current); rank 0 also writes the index "<stem>.pvtu" and the
+// contact face to vtu_companion(path) (from the contact vectors, which every
+// rank holds whole). Returns the face file's path on rank 0, "" elsewhere.
+std::string write_pvtu(OutputSet& out, const std::string& path, const Problem& P, const Slab& s,
+                       const std::vector<real>& u_local, const ContactFields& c, VtkFormat format = VtkFormat::binary);
+std::string pvtu_piece_name(const std::string& path, int rank);
 
 // A ParaView collection: each (time, file) is one step; a step's files are
 // its parts (here the body and its contact face). `files` are written
