@@ -6,6 +6,8 @@
 
 #include "core/contact/nested.hpp"
 #include "core/parallel/comm.hpp"
+#include "core/parallel/distributed_multigrid.hpp"
+#include "core/parallel/row_fetch.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
@@ -74,16 +76,16 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
       newton.u0 = &u0;
       newton.lambda0 = &lambda0;
     }
-    // the 3D guesses are whole-grid vectors on one rank only (several
-    // ranks: the inner solves start cold; core/parallel has no transfer of
-    // slab vectors between meshes yet)
-    if (C.converged() && !Comm::world().distributed()) {
-      const Transfer T = build_transfer(R.problem->grid, C.problem->grid);
-      const index n = R.problem->dofs();
+    if (C.converged()) {
+      // on the slab this mesh's operators will use (the whole grid on one rank)
+      const Comm& comm = Comm::world();
+      const GridDims& g = R.problem->grid;
+      const Slab fine = worth_distributing(g, comm) ? make_slab(g, comm.rank(), comm.size()) : make_slab(g, 0, 1);
+      const index n = 3 * fine.local.nodes();
       load_guess.resize(n);
       extension.resize(n);
-      prolongate(T, 3, C.interior_load.data(), load_guess.data());
-      prolongate(T, 3, C.u_full.data(), extension.data());  // E u_c + K_ii^{-1} l_i
+      prolongate_slabs(C.slab, C.interior_load.data(), fine, load_guess.data(), comm);
+      prolongate_slabs(C.slab, C.u_full.data(), fine, extension.data(), comm);  // E u_c + K_ii^{-1} l_i
       axpy(n, -1, load_guess.data(), extension.data());
       newton.extension0 = &extension;
     }

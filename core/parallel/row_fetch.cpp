@@ -5,6 +5,8 @@
 #include <string>
 #include <type_traits>
 
+#include "kernels/transfer.hpp"
+
 #ifdef TRESCA_HAVE_MPI
 #include <mpi.h>
 #endif
@@ -100,5 +102,23 @@ void RowFetch::fetch(const T* local, T* out) const {
 }
 template void RowFetch::fetch<real>(const real*, real*) const;
 template void RowFetch::fetch<float>(const float*, float*) const;
+
+void prolongate_slabs(const Slab& coarse, const real* uc, const Slab& fine, real* uf, const Comm& comm) {
+  const Transfer T = build_transfer(fine.global, coarse.global);
+  const Interp1D& Y = T.axis[1];
+  const index f0 = fine.y_begin - fine.lo, f1 = fine.y_end + fine.hi, nyc = coarse.global.ny();
+  if (coarse.ranks == 1) {  // the coarse vector is whole here
+    prolongate(f0 == 0 && f1 == fine.global.ny() ? T : slice_rows(T, f0, f1, 0, nyc), 3, uc, uf);
+    return;
+  }
+  index ca = nyc, cb = 0;
+  for (index i = f0; i < f1; ++i) ca = std::min(ca, Y.j0[i]), cb = std::max(cb, Y.j0[i] + 2);
+  cb = std::min(cb, nyc);
+  ca = std::min(ca, cb - 2);
+  const RowFetch fetch(coarse, ca, cb, comm);
+  std::vector<real> rows(3 * fetch.box().nodes());
+  fetch.fetch(uc, rows.data());
+  prolongate(slice_rows(T, f0, f1, ca, cb), 3, rows.data(), uf);
+}
 
 }  // namespace tresca

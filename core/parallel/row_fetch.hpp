@@ -47,4 +47,11 @@ class RowFetch {
 // the rows [a, b) of g as a box of their own (spacing up to rounding, slab.hpp)
 GridDims row_box(const GridDims& g, index a, index b);
 
+// uf = P uc between two meshes of one box (trilinear, build_transfer), each
+// a 3-component vector on its slab (a slab of one rank: the whole grid,
+// held by every rank): the coarse rows the fine slab's rows interpolate
+// from are fetched from their owners. Collective over comm. The nested
+// iteration's warm starts on several ranks (run.cpp).
+void prolongate_slabs(const Slab& coarse, const real* uc, const Slab& fine, real* uf, const Comm& comm = Comm::world());
+
 }  // namespace tresca
