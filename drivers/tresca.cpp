@@ -395,6 +395,11 @@ int main(int argc, char** argv) {
                 R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9);
     std::printf("times [s]: nested %.3f, setup %.3f, condense %.3f, solve %.3f, recover %.3f, total %.3f\n",
                 R.times.nested, R.times.setup, R.times.condense, R.times.solve, R.times.recover, R.times.total);
+    if (comm.distributed()) {
+      const CommCounters& c = comm_counters();
+      std::printf("communication (rank 0, whole run): %lld messages, %.1f MB point-to-point, %lld allreduces, "
+                  "%lld allgathers\n", c.messages, c.bytes / 1e6, c.allreduces, c.allgathers);
+    }
     if (profile) std::printf("\nkernel profile (%s, %d threads)\n%s", build_info().c_str(), threads,
                              profile_table(R.times.total).c_str());
     try {

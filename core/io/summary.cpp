@@ -63,6 +63,11 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["eps"] = eps;
   j["threads"] = threads;  // per rank
   j["ranks"] = Comm::world().size();
+  if (Comm::world().distributed()) {  // what rank 0 sent over the whole run (comm.hpp)
+    const CommCounters& c = comm_counters();
+    j["communication_rank0"] = {{"messages", c.messages}, {"bytes", c.bytes}, {"allreduces", c.allreduces},
+                                {"allgathers", c.allgathers}};
+  }
   j["build"] = build_info();
   j["mg_precision"] = to_string(opt.mg.precision);
   j["newton_iterations"] = N.iterations;

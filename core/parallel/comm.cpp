@@ -19,6 +19,11 @@ Comm& world_instance() {
 
 const Comm& Comm::world() { return world_instance(); }
 
+CommCounters& comm_counters() {
+  static CommCounters c;
+  return c;
+}
+
 bool mpi_enabled() {
 #ifdef TRESCA_HAVE_MPI
   return true;
@@ -52,6 +57,7 @@ real Comm::sum(real local) const {
   if (size_ > 1) {
     real global = 0;
     MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    comm_counters().allreduces += 1;
     return global;
   }
 #endif
@@ -60,7 +66,10 @@ real Comm::sum(real local) const {
 
 void Comm::sum(real* values, int n) const {
 #ifdef TRESCA_HAVE_MPI
-  if (size_ > 1) MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  if (size_ > 1) {
+    MPI_Allreduce(MPI_IN_PLACE, values, n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    comm_counters().allreduces += 1;
+  }
 #else
   (void)values;
   (void)n;
@@ -72,6 +81,7 @@ double Comm::max(double local) const {
   if (size_ > 1) {
     double global = 0;
     MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    comm_counters().allreduces += 1;
     return global;
   }
 #endif
@@ -80,8 +90,11 @@ double Comm::max(double local) const {
 
 void Comm::allgather(real* v, const std::vector<int>& counts, const std::vector<int>& displs) const {
 #ifdef TRESCA_HAVE_MPI
-  if (size_ > 1)
+  if (size_ > 1) {
     MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, v, counts.data(), displs.data(), MPI_DOUBLE, MPI_COMM_WORLD);
+    comm_counters().allgathers += 1;
+    comm_counters().bytes += double(counts[rank_]) * sizeof(real) * (size_ - 1);
+  }
 #else
   (void)v;
   (void)counts;

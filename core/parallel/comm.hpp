@@ -35,6 +35,15 @@ class Comm {
   friend class MpiSession;
 };
 
+// What this rank has sent since the start (or the last reset): point-to-point
+// messages and bytes (ghost exchanges, row fetches counted per peer),
+// allreduces and allgathers. Counted where they are posted; one rank: zeros.
+struct CommCounters {
+  long long messages = 0, allreduces = 0, allgathers = 0;
+  double bytes = 0;
+};
+CommCounters& comm_counters();
+
 // MPI_Init_thread / MPI_Finalize around main (RAII). Without MPI: nothing.
 class MpiSession {
  public:

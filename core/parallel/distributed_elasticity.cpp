@@ -86,6 +86,8 @@ void DistributedElasticity::begin_exchange(const T* x) const {
   counts_.exchanges += 1;
   counts_.messages += slab_.lo + slab_.hi;
   counts_.bytes += double(slab_.lo + slab_.hi) * n * sizeof(T);
+  comm_counters().messages += slab_.lo + slab_.hi;
+  comm_counters().bytes += double(slab_.lo + slab_.hi) * n * sizeof(T);
 #else
   (void)x;
 #endif

@@ -94,6 +94,11 @@ void RowFetch::fetch(const T* local, T* out) const {
     const MPI_Datatype type = std::is_same<T, float>::value ? MPI_FLOAT : MPI_DOUBLE;
     MPI_Alltoallv(send.data(), send_counts_.data(), send_displs_.data(), type, recv.data(), recv_counts_.data(),
                   recv_displs_.data(), type, MPI_COMM_WORLD);
+    for (int q = 0; q < P; ++q)
+      if (q != comm_.rank() && send_counts_[q]) {
+        comm_counters().messages += 1;
+        comm_counters().bytes += double(send_counts_[q]) * sizeof(T);
+      }
   } else
 #endif
     std::copy(send.begin(), send.end(), recv.begin());
