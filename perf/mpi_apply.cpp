@@ -35,7 +35,7 @@ using namespace tresca;
 
 static const char* kHelp =
     "usage: mpi_apply [--level L | --dims EXxEYxEZ] [--reps N] [--rtol R] [--max-iterations N] [--threads N]\n"
-    "                 [--project LEVEL,RANKS] [--latency S] [--bandwidth B/s] [--rate DOF/s]\n"
+    "                 [--project LEVEL,RANKS] [--latency S] [--bandwidth B/s] [--rate DOF/s] [--outer N] [--inner N]\n"
     "The distributed elasticity apply and a Jacobi-CG on y-slabs, one per MPI rank (default --level 8).\n"
     "Run it with mpirun -np P; --project prints the communication model's projection instead.\n";
 
@@ -74,6 +74,15 @@ int project(const Args& a) {
   std::printf("communication share without overlap: apply %.1f %%, MG-CG iteration %.1f %%\n",
               100 * net.seconds(ap, ranks) / (t_apply + net.seconds(ap, ranks)),
               100 * net.seconds(it, ranks) / (t_it + net.seconds(it, ranks)));
+  // a Newton step with the counts measured at levels 10-12 (--outer per
+  // step, --inner per S apply; perf/RESULTS.md §0g)
+  const double outer = a.real_value("--outer", 3.5), inner = a.real_value("--inner", 6);
+  const CommVolume st = newton_step_comm(H->grids, px, py, MGOptions{}.degree, outer, inner, spec.contact_nodes());
+  const double t_step = ((outer + 2) * (inner * (1 + cycle) + 2.0 / double(g.nz())) + outer * cycle) * t_apply;
+  std::printf("Newton step (%.1f outer, %.0f inner per S apply): %.0f messages %10.4g bytes %.0f allreduces -> %.3g s "
+              "against %.3g s of compute (%.1f %%)\n",
+              outer, inner, st.messages, st.bytes, st.allreduces, net.seconds(st, ranks), t_step,
+              100 * net.seconds(st, ranks) / (t_step + net.seconds(st, ranks)));
   return 0;
 }
 
@@ -85,7 +94,7 @@ int main(int argc, char** argv) {
   const Comm& comm = Comm::world();
   try {
     Args a(argc, argv,
-           {"--level", "--dims", "--reps", "--rtol", "--max-iterations", "--threads", "--project", "--latency", "--bandwidth", "--rate"},
+           {"--level", "--dims", "--reps", "--rtol", "--max-iterations", "--threads", "--project", "--latency", "--bandwidth", "--rate", "--outer", "--inner"},
            {"--help"});
     if (a.has("--help")) {
       if (comm.rank() == 0) std::fputs(kHelp, stdout);

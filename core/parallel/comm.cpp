@@ -102,6 +102,20 @@ void Comm::allgather(real* v, const std::vector<int>& counts, const std::vector<
 #endif
 }
 
+void Comm::broadcast(real* v, int n, int root) const {
+#ifdef TRESCA_HAVE_MPI
+  if (size_ > 1) {
+    MPI_Bcast(v, n, MPI_DOUBLE, root, MPI_COMM_WORLD);
+    comm_counters().allgathers += 1;  // a collective of the same kind
+    if (rank_ == root) comm_counters().bytes += double(n) * sizeof(real) * (size_ - 1);
+  }
+#else
+  (void)v;
+  (void)n;
+  (void)root;
+#endif
+}
+
 int Comm::ranks_on_this_host() const {
 #ifdef TRESCA_HAVE_MPI
   if (size_ > 1) {

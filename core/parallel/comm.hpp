@@ -27,6 +27,8 @@ class Comm {
   // in place: rank q's part v[displs[q] .. displs[q] + counts[q]) to every rank
   void allgather(real* v, const std::vector<int>& counts, const std::vector<int>& displs) const;
   void barrier() const;
+  // v[0..n) of rank `root` to every rank
+  void broadcast(real* v, int n, int root = 0) const;
   // how many ranks run on this rank's machine (MPI_COMM_TYPE_SHARED)
   int ranks_on_this_host() const;
 

@@ -48,6 +48,25 @@ CommVolume mgcg_iteration(const std::vector<GridDims>& grids, int px, int py, in
   return v;
 }
 
+CommVolume contact_allgather(index contact_nodes, int ranks) {
+  if (ranks <= 1) return {};
+  const double share = 3.0 * double(contact_nodes) / ranks * sizeof(double);
+  return {double(ranks - 1), share * (ranks - 1), 0};
+}
+
+CommVolume newton_step_comm(const std::vector<GridDims>& grids, int px, int py, int degree, double outer, double inner,
+                            index contact_nodes) {
+  const int P = px * py;
+  CommVolume s_apply = mgcg_iteration(grids, px, py, degree) * inner;
+  s_apply += apply_halo(grids.front(), px, py) * 2.0;
+  s_apply += contact_allgather(contact_nodes, P);
+  CommVolume pc = vcycle_halo(grids, px, py, degree);
+  pc += contact_allgather(contact_nodes, P);
+  CommVolume step = s_apply * (outer + 2);
+  step += pc * outer;
+  return step;
+}
+
 void rank_grid(const GridDims& g, int ranks, int& px, int& py) {
   // the factorisation with the least halo bytes per apply
   px = 1;

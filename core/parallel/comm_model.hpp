@@ -31,6 +31,7 @@ struct CommVolume {
     return *this;
   }
   CommVolume operator*(double k) const { return {messages * k, bytes * k, allreduces * k}; }
+  CommVolume operator+(const CommVolume& o) const { return {messages + o.messages, bytes + o.bytes, allreduces + o.allreduces}; }
 };
 
 struct NetworkModel {
@@ -48,6 +49,17 @@ CommVolume slab_apply_halo(const GridDims& g, int neighbours);
 CommVolume vcycle_halo(const std::vector<GridDims>& grids, int px, int py, int degree, double agglomerate_nodes = 4096);
 // one MG-CG iteration: an apply, a V-cycle, two allreduces
 CommVolume mgcg_iteration(const std::vector<GridDims>& grids, int px, int py, int degree);
+
+// the contact vectors (3p doubles) gathered on every rank: ring allgather,
+// P - 1 messages of 3p/P values per rank
+CommVolume contact_allgather(index contact_nodes, int ranks);
+// one Newton step of the contact solver (steklov.hpp, semismooth.hpp): `outer`
+// boundary Krylov iterations, each an S apply (an inner MG-CG solve of
+// `inner` iterations, two plane applies, a contact allgather) and a K + B
+// V-cycle with its allgather; plus two more S applies (the known
+// increments and the bookkeeping S du)
+CommVolume newton_step_comm(const std::vector<GridDims>& grids, int px, int py, int degree, double outer, double inner,
+                            index contact_nodes);
 
 // the most nearly square px x py = ranks with px / py close to nx / ny
 void rank_grid(const GridDims& g, int ranks, int& px, int& py);

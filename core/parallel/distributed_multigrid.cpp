@@ -152,11 +152,14 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
 DistributedMultigrid::~DistributedMultigrid() = default;
 
 void DistributedMultigrid::factor_coarse() {
+  // rank 0 alone factorises and solves the coarsest level (vcycle)
+  const index n = levels_.back()->n;
+  cb_.resize(n);
+  cx_.resize(n);
+  if (comm_.rank() != 0) return;
   SparseMatrix A = assemble(levels_.back()->Ar);
   coarse_.compute(A);
   if (coarse_.info() != Eigen::Success) throw std::runtime_error("distributed multigrid: coarse factorisation failed");
-  cb_.resize(A.rows());
-  cx_.resize(A.rows());
 }
 
 void DistributedMultigrid::refresh_diagonals() {
@@ -359,9 +362,14 @@ void DistributedMultigrid::vcycle(int l) const {
   const Level& lv = *levels_[l];
   const Work<T>& w = lv.work<T>();
   if (l + 1 == int(levels_.size())) {
+    // solved on rank 0 (every rank holds the same right-hand side), the
+    // answer broadcast
     ScopedTimer t(Kernel::coarse_solve);
-    for (index i = 0; i < lv.n; ++i) cb_[i] = real(w.bp[i]);
-    cx_ = coarse_.solve(cb_);
+    if (comm_.rank() == 0) {
+      for (index i = 0; i < lv.n; ++i) cb_[i] = real(w.bp[i]);
+      cx_ = coarse_.solve(cb_);
+    }
+    comm_.broadcast(cx_.data(), int(lv.n));
     for (index i = 0; i < lv.n; ++i) w.xp[i] = T(cx_[i]);
     return;
   }

@@ -11,8 +11,8 @@
 // * a level with fewer than 2 node rows per rank or fewer than
 //   `min_nodes_per_rank` nodes per rank, and every coarser one, is
 //   replicated: every rank holds all of it and computes the same thing
-//   (agglomeration onto all ranks, no messages inside; the coarsest is
-//   solved by each rank's own factorisation);
+//   (agglomeration onto all ranks, no messages inside); the coarsest is
+//   factorised and solved by rank 0 alone, its answer broadcast;
 // * transfers between distributed levels fetch the rows that neighbours
 //   own (row_fetch.hpp): the coarse rows a fine slab interpolates from, the
 //   fine rows a coarse slab restricts from; at the first replicated level
