@@ -1,6 +1,5 @@
 #include "core/parallel/distributed_multigrid.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -10,6 +9,7 @@
 
 #include "kernels/boundary_block.hpp"
 #include "kernels/transfer.hpp"
+#include "core/solvers/smoothing.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
 
@@ -214,20 +214,7 @@ void DistributedMultigrid::set_bottom_block(const std::vector<real>& B) {
     }
     if (l + 1 == levels_.size()) break;
     if (Bl.empty()) continue;
-    // P^T B, lumped per entry (multigrid.cpp)
-    const GridDims& cg = levels_[l + 1]->g;
-    const index Mc = cg.nx() * cg.ny();
-    const Interp1D &X = grids_->to_coarse[l].axis[0], &Y = grids_->to_coarse[l].axis[1];
-    std::vector<real> Bc(4 * Mc, 0.0);
-    for (int fld = 0; fld < 4; ++fld)
-      for (index jy = 0; jy < cg.ny(); ++jy)
-        for (index jx = 0; jx < cg.nx(); ++jx) {
-          real s = 0;
-          for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky)
-            for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx)
-              s += Y.tw[ky] * X.tw[kx] * Bl[fld * M + X.tf[kx] + g.nx() * Y.tf[ky]];
-          Bc[fld * Mc + jx + cg.nx() * jy] = s;
-        }
+    std::vector<real> Bc = project_bottom_block(grids_->to_coarse[l], Bl);  // P^T B (multigrid.cpp)
     Bl = std::move(Bc);
   }
   refresh_diagonals();
@@ -276,12 +263,10 @@ int DistributedMultigrid::distributed_levels() const {
 }
 
 void DistributedMultigrid::estimate_lmax(Level& lv) {
-  // Lanczos through Jacobi-PCG as in multigrid.cpp; start vector hashed from
-  // the global dof index, dot products over all ranks if distributed
+  // multigrid.cpp's estimate; the start vector hashed from the global dof
+  // index (the same on any rank count), dots over all ranks if distributed
   const index n = lv.n;
-  const Comm* comm = lv.distributed ? &comm_ : nullptr;
-  auto global = [&](real s) { return comm ? comm->sum(s) : s; };
-  std::vector<real> x(n, 0), r(n), z(n), p(n), q(n);
+  std::vector<real> r(n);
   const GridDims& box = lv.slab.local;
   const index N = box.nodes(), G = lv.g.nodes(), row0 = lv.slab.y_begin - lv.slab.lo;
   for (int c = 0; c < 3; ++c)
@@ -291,29 +276,9 @@ void DistributedMultigrid::estimate_lmax(Level& lv) {
           r[c * N + box.node(ix, j, iz)] = hashed(std::uint64_t(c * G + lv.g.node(ix, row0 + j, iz)));
   zero_constrained(box, lv.slab.local_faces(faces_), r.data());
   if (lv.distributed) lv.Ad->zero_ghosts(r.data());
-  hadamard(n, lv.dinv.data(), r.data(), z.data());
-  copy(n, z.data(), p.data());
-  real rz = global(dot(n, r.data(), z.data()));
-  std::vector<real> al, be;
-  for (int j = 0; j < 15 && rz > 0; ++j) {
-    lv.A().apply(p.data(), q.data());
-    const real a = rz / global(dot(n, p.data(), q.data()));
-    cg_update(n, a, p.data(), q.data(), x.data(), r.data());
-    hadamard(n, lv.dinv.data(), r.data(), z.data());
-    const real rz_new = global(dot(n, r.data(), z.data()));
-    al.push_back(a);
-    be.push_back(rz_new / rz);
-    xpay(n, z.data(), rz_new / rz, p.data());
-    rz = rz_new;
-  }
-  const int m = int(al.size());
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(m, m);
-  for (int j = 0; j < m; ++j) {
-    T(j, j) = 1 / al[j] + (j > 0 ? be[j - 1] / al[j - 1] : 0);
-    if (j + 1 < m) T(j, j + 1) = T(j + 1, j) = std::sqrt(be[j]) / al[j];
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T, Eigen::EigenvaluesOnly);
-  lv.lmax = 1.15 * std::max(es.eigenvalues().maxCoeff(), real(2));
+  std::function<real(real)> reduce;
+  if (lv.distributed) reduce = [this](real s) { return comm_.sum(s); };
+  lv.lmax = lanczos_lmax(n, [&](const real* p, real* q) { lv.A().apply(p, q); }, lv.dinv, std::move(r), reduce);
 }
 
 template <class T>
@@ -336,25 +301,9 @@ template <class T>
 void DistributedMultigrid::smooth(int l, bool zero_guess) const {
   const Level& lv = *levels_[l];
   const Work<T>& w = lv.work<T>();
-  const index n = lv.n;
   ScopedTimer t(Kernel::smoother);
-  const real lmax = lv.lmax, lmin = lmax / opt_.range;
-  const real theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
-  T *x = w.xp, *r = w.r.data(), *d = w.d.data();
-  if (zero_guess) {
-    cheb_first<T>(n, T(1 / theta), w.dinv.data(), w.bp, d, x);
-  } else {
-    residual<T>(lv, w.bp, x, r);
-    fill<T>(n, 0, d);
-    cheb_update<T>(n, 0, T(1 / theta), w.dinv.data(), r, d, x);
-  }
-  real rho = 1 / sigma;
-  for (int k = 1; k < opt_.degree; ++k) {
-    residual<T>(lv, w.bp, x, r);
-    const real rho_new = 1 / (2 * sigma - rho);
-    cheb_update<T>(n, T(rho_new * rho), T(2 * rho_new / delta), w.dinv.data(), r, d, x);
-    rho = rho_new;
-  }
+  chebyshev_smooth<T>(lv.n, lv.lmax, opt_.range, opt_.degree, zero_guess, w.dinv.data(), w.bp, w.xp, w.r.data(),
+                      w.d.data(), [&](const T* x, T* r) { residual<T>(lv, w.bp, x, r); });
 }
 
 template <class T>

@@ -1,12 +1,12 @@
 #include "core/solvers/multigrid.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
 
 #include "kernels/boundary_block.hpp"
+#include "core/solvers/smoothing.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
 
@@ -138,9 +138,8 @@ void Multigrid::refresh_work() {
 }
 
 void Multigrid::estimate_lmax(Level& lv) {
-  // Lanczos through Jacobi-PCG: T_jj = 1/a_j + b_{j-1}/a_{j-1}, T_j,j+1 = sqrt(b_j)/a_j
   const index n = lv.A.size();
-  std::vector<real> x(n, 0), r(n), z(n), p(n), q(n), dinv = lv.A.diagonal();
+  std::vector<real> r(n), dinv = lv.A.diagonal();
   for (real& v : dinv) v = 1 / v;
   std::uint64_t s = 12345;
   for (index i = 0; i < n; ++i) {
@@ -148,31 +147,7 @@ void Multigrid::estimate_lmax(Level& lv) {
     r[i] = real((s >> 11) & 0xFFFFF) / real(0xFFFFF) - 0.5;
   }
   zero_constrained(lv.A.grid(), lv.A.faces(), r.data());
-  hadamard(n, dinv.data(), r.data(), z.data());
-  copy(n, z.data(), p.data());
-  real rz = dot(n, r.data(), z.data());
-  std::vector<real> al, be;
-  const int its = 15;
-  for (int j = 0; j < its && rz > 0; ++j) {
-    lv.A.apply(p.data(), q.data());
-    const real a = rz / dot(n, p.data(), q.data());
-    cg_update(n, a, p.data(), q.data(), x.data(), r.data());
-    hadamard(n, dinv.data(), r.data(), z.data());
-    const real rz_new = dot(n, r.data(), z.data());
-    al.push_back(a);
-    be.push_back(rz_new / rz);
-    xpay(n, z.data(), rz_new / rz, p.data());
-    rz = rz_new;
-  }
-  const int m = int(al.size());
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(m, m);
-  for (int j = 0; j < m; ++j) {
-    T(j, j) = 1 / al[j] + (j > 0 ? be[j - 1] / al[j - 1] : 0);
-    if (j + 1 < m) T(j, j + 1) = T(j + 1, j) = std::sqrt(be[j]) / al[j];
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T, Eigen::EigenvaluesOnly);
-  // B terms of the Newton preconditioner (PSD, 2x2 blocks) keep D^{-1}(K+B) below max(lmax, 2)
-  lv.lmax = 1.15 * std::max(es.eigenvalues().maxCoeff(), real(2));
+  lv.lmax = lanczos_lmax(n, [&](const real* p, real* q) { lv.A.apply(p, q); }, dinv, std::move(r));
 }
 
 void Multigrid::factor_coarse() {
@@ -193,19 +168,7 @@ void Multigrid::set_bottom_block(const std::vector<real>& B) {
       c.A.set_bottom_block({});
       continue;
     }
-    const GridDims &fg = f.A.grid(), &cg = c.A.grid();
-    const index Mf = fg.nx() * fg.ny(), Mc = cg.nx() * cg.ny();
-    const Interp1D &X = grids_->to_coarse[l].axis[0], &Y = grids_->to_coarse[l].axis[1];
-    std::vector<real> Bc(4 * Mc, 0.0);
-    for (int fld = 0; fld < 4; ++fld)
-      for (index jy = 0; jy < cg.ny(); ++jy)
-        for (index jx = 0; jx < cg.nx(); ++jx) {
-          real s = 0;
-          for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky)
-            for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx)
-              s += Y.tw[ky] * X.tw[kx] * Bf[fld * Mf + X.tf[kx] + fg.nx() * Y.tf[ky]];
-          Bc[fld * Mc + jx + cg.nx() * jy] = s;
-        }
+    std::vector<real> Bc = project_bottom_block(grids_->to_coarse[l], Bf);
     c.A.set_bottom_block(std::move(Bc));
   }
   factor_coarse();
@@ -234,27 +197,9 @@ void Multigrid::residual(int l, const T* b, const T* x, T* r) const {
 template <class T>
 void Multigrid::smooth(int l, bool zero_guess) const {
   const Work<T>& w = work<T>()[l];
-  const index n = levels_[l].A.size();
   ScopedTimer t(Kernel::smoother);
-  const real lmax = levels_[l].lmax, lmin = lmax / opt_.range;
-  const real theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
-  T* x = w.xp;
-  T* r = w.r.data();
-  T* d = w.d.data();
-  if (zero_guess) {
-    cheb_first<T>(n, T(1 / theta), w.dinv.data(), w.bp, d, x);
-  } else {
-    residual<T>(l, w.bp, x, r);
-    fill<T>(n, 0, d);
-    cheb_update<T>(n, 0, T(1 / theta), w.dinv.data(), r, d, x);
-  }
-  real rho = 1 / sigma;
-  for (int k = 1; k < opt_.degree; ++k) {
-    residual<T>(l, w.bp, x, r);
-    const real rho_new = 1 / (2 * sigma - rho);
-    cheb_update<T>(n, T(rho_new * rho), T(2 * rho_new / delta), w.dinv.data(), r, d, x);
-    rho = rho_new;
-  }
+  chebyshev_smooth<T>(levels_[l].A.size(), levels_[l].lmax, opt_.range, opt_.degree, zero_guess, w.dinv.data(), w.bp,
+                      w.xp, w.r.data(), w.d.data(), [&](const T* x, T* r) { residual<T>(l, w.bp, x, r); });
 }
 
 template <class T>

@@ -1,0 +1,48 @@
+// The pieces of a multigrid V-cycle that do not depend on how a level is
+// stored: shared by Multigrid (multigrid.hpp, one rank) and
+// DistributedMultigrid (core/parallel), so both compute the same thing.
+//
+// * chebyshev_smooth: `degree` steps of the Chebyshev polynomial in D^{-1}A
+//   targeting [lmax/range, lmax]; `residual(x, r)` forms r = b - A x;
+// * lanczos_lmax: the largest eigenvalue of D^{-1}A from 15 steps of
+//   Jacobi-PCG (Lanczos), times 1.15, at least 2.3; dots through `reduce`
+//   (the sum over the ranks of a distributed level);
+// * project_bottom_block: P^T B of a bottom-plane block, lumped per entry.
+#pragma once
+#include <functional>
+#include <vector>
+
+#include "kernels/transfer.hpp"
+#include "kernels/vector_ops.hpp"
+
+namespace tresca {
+
+template <class T, class Residual>
+void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_guess, const T* dinv, const T* b, T* x, T* r,
+                      T* d, Residual&& residual) {
+  const real lmin = lmax / range;
+  const real theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
+  if (zero_guess) {
+    cheb_first<T>(n, T(1 / theta), dinv, b, d, x);
+  } else {
+    residual(x, r);
+    fill<T>(n, 0, d);
+    cheb_update<T>(n, 0, T(1 / theta), dinv, r, d, x);
+  }
+  real rho = 1 / sigma;
+  for (int k = 1; k < degree; ++k) {
+    residual(x, r);
+    const real rho_new = 1 / (2 * sigma - rho);
+    cheb_update<T>(n, T(rho_new * rho), T(2 * rho_new / delta), dinv, r, d, x);
+    rho = rho_new;
+  }
+}
+
+// r: the start vector (overwritten); apply(p, q): q = A p
+real lanczos_lmax(index n, const std::function<void(const real*, real*)>& apply, const std::vector<real>& dinv,
+                  std::vector<real> r, const std::function<real(real)>& reduce = nullptr);
+
+// the coarse bottom block P^T B of the fine one (4 fields of nx*ny each)
+std::vector<real> project_bottom_block(const Transfer& t, const std::vector<real>& fine);
+
+}  // namespace tresca
