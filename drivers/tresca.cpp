@@ -56,6 +56,8 @@ const char* kHelp =
     "  --no-nested        start Newton from x0 = 0 on this mesh (default: nested iteration,\n"
     "                     coarser meshes ceil(e/2) solved first; --table never nests)\n"
     "  --outer-pc mg|none preconditioner of the boundary Newton system (default mg)\n"
+    "  --mg-degree D                 Chebyshev smoothing steps before and after each coarse\n"
+    "                                correction of the V-cycles (default 3, 1..8)\n"
     "  --mg-precision single|double  arithmetic of the multigrid V-cycles (default single;\n"
     "                     the Krylov solvers and all results are double either way)\n"
     "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
@@ -115,7 +117,7 @@ int main(int argc, char** argv) {
   try {
     const Args a(argc, argv,
                   {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--scaling", "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem", "--gap-file", "--vtk-format", "--initial"},
+                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--mg-degree", "--scaling", "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem", "--gap-file", "--vtk-format", "--initial"},
                   {"--quiet", "--help", "--profile", "--no-nested", "--vtk-every-iteration"});
     if (a.has("--help")) {
       std::fputs(kHelp, stdout);
@@ -169,6 +171,9 @@ int main(int argc, char** argv) {
     if (prec != "single" && prec != "double")
       throw std::invalid_argument("--mg-precision '" + prec + "' must be single or double");
     opt.mg.precision = prec == "single" ? Precision::single_precision : Precision::double_precision;
+    const long long degree = a.int_value("--mg-degree", opt.mg.degree);
+    if (degree < 1 || degree > 8) throw std::invalid_argument("--mg-degree " + a.str("--mg-degree") + " must be in 1..8");
+    opt.mg.degree = int(degree);
     if (a.has("--phi")) opt.coulomb = -1;  // the command line's Tresca bound over a file's Coulomb
     const std::string method = a.str("--coulomb-method", to_string(RunOptions{}.coulomb_method));
     opt.coulomb_method = coulomb_method_from(method, "--coulomb-method");
