@@ -29,22 +29,26 @@ void BoundaryPreconditioner::update(const std::vector<real>& h, const std::vecto
                                     const std::vector<std::uint8_t>& free_mask) {
   const Problem& P = S_.problem();
   const GridDims& g = P.grid;
-  const index M = g.nx() * g.ny(), p = P.contact_nodes();
+  const index M = g.nx() * g.ny(), p = S_.contact_nodes(), first = S_.first_contact_node();
   if (index(h.size()) != 3 * p || index(fixed.size()) != 3 * p || index(free_mask.size()) != 3 * p)
     throw std::invalid_argument("BoundaryPreconditioner::update: h, fixed and free must have 3p = " +
                                 std::to_string(3 * p) + " entries");
+  // B over the whole bottom plane: this rank's contact nodes, then (several
+  // ranks) the sum of every rank's, which own disjoint nodes
   std::vector<real> B(4 * M, 0.0);
   for (index c = 0; c < p; ++c) {
-    const index n = P.contact_grid_node(c);  // bottom plane: grid node index = plane index
+    const index n = P.contact_grid_node(first + c);  // bottom plane: grid node index = plane index
     B[0 * M + n] = fixed[c] ? kPenalty * kdiag_[c] : h[c];
     B[1 * M + n] = (fixed[c] || fixed[p + c]) ? 0 : h[p + c];
     B[2 * M + n] = fixed[p + c] ? kPenalty * kdiag_[p + c] : h[2 * p + c];
     B[3 * M + n] = fixed[2 * p + c] ? kPenalty * kdiag_[2 * p + c] : 0;
   }
-  if (dmg_)
+  if (dmg_) {
+    S_.comm().sum(B.data(), int(B.size()));
     dmg_->set_bottom_block(B);
-  else
+  } else {
     mg_->set_bottom_block(B);
+  }
   free_ = free_mask;
 }
 

@@ -14,8 +14,8 @@
 // a tenth of one S application.
 //
 // Several ranks (S.distributed()): the V-cycle is DistributedMultigrid's;
-// B is built over the whole bottom plane on every rank from the (whole)
-// contact vectors, so setting it needs no messages.
+// each rank fills B at its contact nodes and one allreduce of the plane
+// (4 nx ny values per Newton step) gives every rank the whole of it.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -47,7 +47,7 @@ class BoundaryPreconditioner : public LinearOperator {
   const SteklovPoincare& S_;
   std::unique_ptr<Multigrid> mg_;             // one rank
   std::unique_ptr<DistributedMultigrid> dmg_;  // several
-  std::vector<real> kdiag_;  // diag of K at the contact nodes (3 blocks of p)
+  std::vector<real> kdiag_;  // diag of K at this rank's contact nodes (3 blocks)
   std::vector<std::uint8_t> free_;
   mutable std::vector<real> full_in_, full_out_;
 };

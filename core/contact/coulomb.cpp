@@ -55,6 +55,8 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, const std::vector<re
       dmax = std::max(dmax, std::abs(f[i]));
       pmax = std::max(pmax, G[i]);
     }
+    dmax = S.max(dmax);  // over all ranks' contact nodes
+    pmax = S.max(pmax);
     const real last_change = change;
     change = pmax > 0 ? dmax / pmax : 0;
     C.changes.push_back(change);
@@ -84,8 +86,8 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, const std::vector<re
       Eigen::MatrixXd A(k, k);
       Eigen::VectorXd rhs(k);
       for (int a = 0; a < k; ++a) {
-        rhs[a] = dot(p, dF[a].data(), f.data());
-        for (int b = 0; b < k; ++b) A(a, b) = dot(p, dF[a].data(), dF[b].data());
+        rhs[a] = S.sum(dot(p, dF[a].data(), f.data()));
+        for (int b = 0; b < k; ++b) A(a, b) = S.sum(dot(p, dF[a].data(), dF[b].data()));
       }
       const Eigen::VectorXd gamma = A.ldlt().solve(rhs);
       if (gamma.allFinite())

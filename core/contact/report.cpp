@@ -23,9 +23,10 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
   // the residual is the paper's |v̂| either way; the status (which nodes are
   // in contact, which stick) is decided in Newton's metric R.scale, so that
   // it does not depend on the units where a node is on the edge of two states
-  F.true_residual = std::sqrt(approximation_step(p, law.law(), R.scale.empty() ? nullptr : R.scale.data(), R.u.data(), R.lambda.data(), F.r.data(), v.data(),
-                                                 d.data(), F.status.data()));
-  F.btilde_norm = norm2(3 * p, btilde.data());
+  F.true_residual = std::sqrt(S.sum(approximation_step(p, law.law(), R.scale.empty() ? nullptr : R.scale.data(),
+                                                       R.u.data(), R.lambda.data(), F.r.data(), v.data(), d.data(),
+                                                       F.status.data())));
+  F.btilde_norm = std::sqrt(S.sum(dot(3 * p, btilde.data(), btilde.data())));
   F.true_residual_relative = F.btilde_norm > 0 ? F.true_residual / F.btilde_norm : F.true_residual;
   F.ux_min = INFINITY;
   F.uz_max = -INFINITY;
@@ -52,6 +53,13 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
     F.uz_max = std::max(F.uz_max, uz);
     F.lambda_sum += lam;
   }
+  // over all ranks (each holds its own contact nodes; identity on one rank)
+  for (real* m : {&F.equilibrium, &F.uz_violation, &F.lambda_violation, &F.complementarity, &F.friction_bound,
+                  &F.friction_direction, &F.stick_slip, &F.uz_max})
+    *m = S.max(*m);
+  F.ux_min = -S.max(-F.ux_min);
+  for (index* c : {&F.active, &F.separated, &F.sticking, &F.sliding}) *c = index(S.sum(real(*c)));
+  F.lambda_sum = S.sum(F.lambda_sum);
   F.friction_bound = std::max(F.friction_bound, real(0));
   return F;
 }

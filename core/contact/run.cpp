@@ -104,6 +104,19 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
       opt.iterate_done(Iterate{R.problem.get(), step++, &pr, &u_full, &R.contact.gap});
     };
   }
+  // this rank's contact nodes (all of them on one rank): the law and a given initial iterate
+  ContactConditions law = R.contact;
+  std::vector<real> u0_local, lambda0_local;
+  if (S.distributed()) {
+    law.phi = S.local_part(R.contact.phi, 1);
+    law.gap = S.local_part(R.contact.gap, 1);
+    if (newton.u0 && newton.lambda0) {
+      u0_local = S.local_part(*newton.u0, 3);
+      lambda0_local = S.local_part(*newton.lambda0, 1);
+      newton.u0 = &u0_local;
+      newton.lambda0 = &lambda0_local;
+    }
+  }
   std::vector<real> btilde;
   const SolveStats cond = S.condensed_load(opt.tight_rtol, btilde, &R.interior_load,
                                            load_guess.empty() ? nullptr : load_guess.data());
@@ -112,7 +125,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   if (opt.phase_done) opt.phase_done("condensed load", t2 - t1);
   if (!cond.ok()) {
     // b̃ is untrustworthy: report instead of iterating on a wrong problem
-    const index p = R.problem->contact_nodes();
+    const index p = S.contact_nodes();
     R.newton.reason = NewtonReason::inner_failure;
     R.newton.u.assign(3 * p, 0);
     R.newton.lambda.assign(p, 0);
@@ -121,8 +134,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.coulomb = true;
     newton.coulomb = opt.coulomb;
     newton.coulomb_newton = opt.coulomb_method == RunOptions::CoulombMethod::newton;
-    R.newton = semismooth_newton(S, btilde, R.contact, newton);
-    R.contact.phi = R.newton.phi;
+    R.newton = semismooth_newton(S, btilde, law, newton);
+    law.phi = R.newton.phi;
     R.coulomb_loop.iterations = 1;
     R.coulomb_loop.reason = R.newton.converged() ? CoulombReason::converged : CoulombReason::tresca_failed;
     R.coulomb_loop.newton_steps = R.newton.iterations;
@@ -133,23 +146,41 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     CoulombOptions co;
     co.F = opt.coulomb;
     co.tol = opt.coulomb_tol;
-    R.coulomb_loop = coulomb_fixed_point(S, btilde, R.contact, co, newton);
+    R.coulomb_loop = coulomb_fixed_point(S, btilde, law, co, newton);
     R.newton = std::move(R.coulomb_loop.last);
     R.coulomb_loop.last = {};
-    R.contact = R.coulomb_loop.law;
+    law = R.coulomb_loop.law;
   } else {
-    R.newton = semismooth_newton(S, btilde, R.contact, newton);
+    R.newton = semismooth_newton(S, btilde, law, newton);
   }
-  if (R.coulomb)
-    for (index i = 0; i < R.problem->contact_nodes(); ++i)
-      R.coulomb_consistency = std::max(R.coulomb_consistency,
-                                       std::abs(R.contact.phi[i] - opt.coulomb * std::max(real(0), R.newton.lambda[i])));
+  if (R.coulomb) {
+    for (index i = 0; i < S.contact_nodes(); ++i)
+      R.coulomb_consistency =
+          std::max(R.coulomb_consistency, std::abs(law.phi[i] - opt.coulomb * std::max(real(0), R.newton.lambda[i])));
+    R.coulomb_consistency = S.max(R.coulomb_consistency);
+  }
   const double t3 = wall_time();
   if (opt.phase_done) opt.phase_done("semismooth* Newton", t3 - t2);
   // the final check's tight S u, warm from E u0 when there is one, also
   // gives E u: u = E u + K_ii^{-1} l_i
   const bool warm = !extension.empty();
-  R.report = final_report(S, btilde, R.contact, R.newton, opt.tight_rtol, &extension, warm);
+  R.report = final_report(S, btilde, law, R.newton, opt.tight_rtol, &extension, warm);
+  if (S.distributed()) {
+    // the run's results for every contact node on every rank (outputs, the
+    // next finer mesh of nested iteration)
+    NewtonResult& N = R.newton;
+    N.u = S.whole(N.u, 3);
+    N.lambda = S.whole(N.lambda, 1);
+    N.Su = S.whole(N.Su, 3);
+    N.status = S.whole(N.status);
+    N.phi = S.whole(N.phi, 1);
+    if (!N.scale.empty()) N.scale = S.whole(N.scale, 1);
+    law.phi = S.whole(law.phi, 1);
+    law.gap = S.whole(law.gap, 1);
+    R.report.r = S.whole(R.report.r, 3);
+    R.report.status = S.whole(R.report.status);
+  }
+  R.contact = std::move(law);
   R.slab = S.distributed() ? S.slab() : make_slab(R.problem->grid, 0, 1);
   if (opt.recover_interior) {
     R.u_full = std::move(extension);

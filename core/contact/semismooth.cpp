@@ -195,7 +195,7 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
   if (M) M->update(L.h, L.fixed, L.free);
   ReducedNewtonOperator A(S, L, work);
   CGOptions co;
-  const real target = std::max(floor, eta * norm2(n3, L.rhs.data()));
+  const real target = std::max(floor, eta * std::sqrt(S.sum(dot(n3, L.rhs.data(), L.rhs.data()))));
   co.rtol = 1e-13;  // attainable floor relative to |rhs|
   co.atol = target;
   co.max_iterations = M ? 200 : 5000;
@@ -203,6 +203,7 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
   // like target/|r_j| as the outer residual r_j falls
   co.on_residual = [&](real rn) { A.set_inner_rtol(std::clamp(target / rn, real(1e-12), inner_max)); };
   co.abort_if = [&] { return work.failures > fails0; };  // an S apply is untrustworthy
+  co.comm = S.distributed() ? &S.comm() : nullptr;      // contact vectors over the ranks
   if (L.coupled) {
     // not symmetric: GMRES with the same preconditioner. The inner accuracy
     // is fixed at 0.3 eta (0.1: 2-9 % more work, 1: a fifth Newton step at
@@ -216,6 +217,7 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
     go.max_iterations = co.max_iterations;
     A.set_inner_rtol(std::clamp(0.3 * eta, real(1e-12), inner_max));
     go.abort_if = co.abort_if;
+    go.comm = co.comm;
     ScopedTimer t(Kernel::outer_cg);
     out.outer = gmres(A, M, L.rhs.data(), du.data(), go);
     std::fill(Sdu.begin(), Sdu.end(), 0.0);
@@ -316,10 +318,12 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   CGWorkspace ws;
   const real* scale_ptr = scale.empty() ? nullptr : scale.data();
   real smax = 0;  // Coulomb Newton: bounds |S Δu| by smax |Δu| for the bookkeeping apply
-  if (opt.coulomb_newton)
+  if (opt.coulomb_newton) {
     for (real s : (scale.empty() ? step_scale(S) : scale)) smax = std::max(smax, s);
+    smax = S.max(smax);
+  }
 
-  const real bnorm = norm2(n3, btilde.data());
+  const real bnorm = std::sqrt(S.sum(dot(n3, btilde.data(), btilde.data())));
   bool last_step_hit_limit = false;
   real eta = opt.forcing_max;
   for (int k = 0;; ++k) {
@@ -330,8 +334,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
       for (index i = 0; i < n3; ++i) r[i] = R.Su[i] - btilde[i];
       if (opt.coulomb >= 0)
         for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * std::max(real(0), R.lambda[i]);
-      vnorm = std::sqrt(approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), r.data(), v.data(), d.data(),
-                                           R.status.data()));
+      vnorm = std::sqrt(S.sum(approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), r.data(), v.data(),
+                                                 d.data(), R.status.data())));
       if (opt.coulomb >= 0 && opt.coulomb_newton) {
         // the step's point on the Coulomb graph: its pressure d_4 sets the
         // bound of its friction force (v̂, the residual, stays at lambda)
@@ -350,6 +354,10 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
         (R.status[i] & kContact ? pr.active : pr.separated) += 1;
         (R.status[i] & kStick ? pr.sticking : pr.sliding) += 1;
       }
+      pr.active = index(S.sum(real(pr.active)));  // counts over all ranks
+      pr.separated = index(S.sum(real(pr.separated)));
+      pr.sticking = index(S.sum(real(pr.sticking)));
+      pr.sliding = index(S.sum(real(pr.sliding)));
       opt.progress(pr);
     }
     if (!std::isfinite(vnorm)) return finish(NewtonReason::non_finite);
@@ -359,8 +367,11 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     if (stagnated(R.history, opt.stagnation_window)) return finish(NewtonReason::stagnation);
 
     // 2. linearisation: known increments, free set, H, right-hand side
-    const bool any_known = linearise(p, law, scale_ptr, R.u, R.lambda, R.status, v, d,
-                                     opt.coulomb >= 0 && opt.coulomb_newton ? opt.coulomb : real(-1), L);
+    // (any rank's known increments make every rank apply S to them: S is collective)
+    const bool any_known = S.max(linearise(p, law, scale_ptr, R.u, R.lambda, R.status, v, d,
+                                           opt.coulomb >= 0 && opt.coulomb_newton ? opt.coulomb : real(-1), L)
+                                     ? 1
+                                     : 0) > 0;
     // Forcing term (Eisenstat–Walker, choice 2, safeguarded): the step is
     // solved to eta_k relative, eta_k -> 0 as |v̂| falls (superlinear).
     if (k > 0) {
@@ -394,7 +405,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     // accuracy of book_accuracy |b̃| (relative to the CG's estimate of S Δu).
     for (index i = 0; i < n3; ++i) du[i] += L.known[i];
     // |S Δu| from the CG's side product, or (GMRES) bounded by max s |Δu|
-    const real sdu_norm = L.coupled ? smax * norm2(n3, du.data()) : norm2(n3, Sdu.data());
+    const real sdu_norm = L.coupled ? smax * std::sqrt(S.sum(dot(n3, du.data(), du.data())))
+                                    : std::sqrt(S.sum(dot(n3, Sdu.data(), Sdu.data())));
     const real book_rtol =
         sdu_norm > 0 ? std::clamp(opt.book_accuracy * bnorm / sdu_norm, real(1e-12), real(1e-1)) : real(1e-1);
     R.operator_applications += 1;

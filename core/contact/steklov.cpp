@@ -20,6 +20,7 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
     const index ex = P.grid.ex;
     c_begin_ = ex * dmg_->fine_slab().y_begin;
     c_end_ = ex * dmg_->fine_slab().y_end;
+    p_ = c_end_ - c_begin_;  // contact vectors hold this rank's nodes
     counts_.resize(comm.size());
     displs_.resize(comm.size());
     for (int q = 0; q < comm.size(); ++q) {
@@ -28,6 +29,7 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
       displs_[q] = int(ex * s.y_begin);
     }
   } else {
+    c_end_ = p_;
     K_ = ElasticityOperator(P.grid, P.dirichlet_faces, P.spec.E, P.spec.nu);
     mg_ = std::make_unique<Multigrid>(GridHierarchy::build(P.grid, mg.coarse_nodes),
                                       elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mg);
@@ -50,24 +52,53 @@ const GridDims& SteklovPoincare::box() const { return dmg_ ? dmg_->fine_slab().l
 
 void SteklovPoincare::scatter(const real* vc, real* full) const {
   const GridDims& g = box();
-  const index N = g.nodes(), ex = P_.grid.ex;
-  const index c0 = dmg_ ? c_begin_ : 0, c1 = dmg_ ? c_end_ : p_, row0 = dmg_ ? slab().y_begin - slab().lo : 0;
-  for (index c = c0; c < c1; ++c) {
+  const index N = g.nodes(), ex = P_.grid.ex, row0 = dmg_ ? slab().y_begin - slab().lo : 0;
+  for (index c = c_begin_; c < c_end_; ++c) {
     const index n = g.node(1 + c % ex, c / ex - row0, 0);
-    for (int a = 0; a < 3; ++a) full[a * N + n] = vc[a * p_ + c];
+    for (int a = 0; a < 3; ++a) full[a * N + n] = vc[a * p_ + c - c_begin_];
   }
 }
 
 void SteklovPoincare::gather(const real* full, real* vc) const {
   const GridDims& g = box();
-  const index N = g.nodes(), ex = P_.grid.ex;
-  const index c0 = dmg_ ? c_begin_ : 0, c1 = dmg_ ? c_end_ : p_, row0 = dmg_ ? slab().y_begin - slab().lo : 0;
-  for (index c = c0; c < c1; ++c) {
+  const index N = g.nodes(), ex = P_.grid.ex, row0 = dmg_ ? slab().y_begin - slab().lo : 0;
+  for (index c = c_begin_; c < c_end_; ++c) {
     const index n = g.node(1 + c % ex, c / ex - row0, 0);
-    for (int a = 0; a < 3; ++a) vc[a * p_ + c] = full[a * N + n];
+    for (int a = 0; a < 3; ++a) vc[a * p_ + c - c_begin_] = full[a * N + n];
   }
-  if (dmg_)
-    for (int a = 0; a < 3; ++a) comm_.allgather(vc + a * p_, counts_, displs_);
+}
+
+real SteklovPoincare::sum(real local) const { return dmg_ ? comm_.sum(local) : local; }
+real SteklovPoincare::max(real local) const { return dmg_ ? real(comm_.max(local)) : local; }
+
+std::vector<real> SteklovPoincare::local_part(const std::vector<real>& whole, int blocks) const {
+  const index pg = P_.contact_nodes();
+  if (index(whole.size()) != blocks * pg)
+    throw std::invalid_argument("SteklovPoincare::local_part: " + std::to_string(whole.size()) + " values, expected " +
+                                std::to_string(blocks * pg));
+  std::vector<real> v(blocks * p_);
+  for (int a = 0; a < blocks; ++a) std::copy_n(whole.data() + a * pg + c_begin_, p_, v.data() + a * p_);
+  return v;
+}
+
+std::vector<real> SteklovPoincare::whole(const std::vector<real>& local, int blocks) const {
+  if (!dmg_ || local.empty()) return local;  // (empty: nothing to gather, e.g. a failed run's S u)
+  if (index(local.size()) != blocks * p_)
+    throw std::invalid_argument("SteklovPoincare::whole: " + std::to_string(local.size()) + " values, expected " +
+                                std::to_string(blocks * p_));
+  const index pg = P_.contact_nodes();
+  std::vector<real> v(blocks * pg, 0.0);
+  for (int a = 0; a < blocks; ++a) {
+    std::copy_n(local.data() + a * p_, p_, v.data() + a * pg + c_begin_);
+    comm_.allgather(v.data() + a * pg, counts_, displs_);
+  }
+  return v;
+}
+
+std::vector<std::uint8_t> SteklovPoincare::whole(const std::vector<std::uint8_t>& local) const {
+  if (!dmg_ || local.empty()) return local;
+  const std::vector<real> w = whole(std::vector<real>(local.begin(), local.end()), 1);
+  return std::vector<std::uint8_t>(w.begin(), w.end());
 }
 
 std::vector<real> SteklovPoincare::contact_diagonal() const {

@@ -18,11 +18,12 @@
 // Ranks (core/parallel): when the run has several MPI ranks and the grid is
 // worth splitting (worth_distributing), the 3D vectors are y-slab local
 // vectors (slab.hpp; full_size() entries), K and the K_ii multigrid are
-// distributed, and the contact vectors stay whole on every rank: each rank
-// scatters its own contact nodes into its slab, and gather collects every
-// rank's nodes on all ranks (MPI_Allgatherv of 3p values per apply, small
-// against the inner solve). The Newton iteration then runs unchanged and
-// identically on every rank. One rank: the threaded code, bit for bit.
+// distributed, and so are the contact vectors: a rank's contact nodes are
+// those of its rows, c in [first_contact_node(), + contact_nodes()), and
+// its contact vectors hold just those (3 blocks of contact_nodes()). Sums
+// and maxima over contact vectors go through sum() and max(); local_part
+// and whole convert from and to vectors of every contact node. One rank:
+// the threaded code, bit for bit.
 //
 // State: the operator is immutable after construction. Every call takes the
 // inner solve's relative tolerance and returns that solve's SolveStats (the
@@ -31,6 +32,7 @@
 #pragma once
 #include <vector>
 
+#include <cstdint>
 #include <memory>
 
 #include "core/solvers/cg.hpp"
@@ -48,7 +50,17 @@ class SteklovPoincare {
  public:
   SteklovPoincare(const Problem& P, const MGOptions& mg = {}, const Comm& comm = Comm::world());
   ~SteklovPoincare();
-  index size() const { return 3 * p_; }
+  index size() const { return 3 * p_; }  // this rank's contact dofs
+  // this rank's contact nodes c in [first_contact_node(), + contact_nodes())
+  index contact_nodes() const { return p_; }
+  index first_contact_node() const { return c_begin_; }
+  // sum and maximum over the ranks of a contact-vector quantity (identity on one rank)
+  real sum(real local) const;
+  real max(real local) const;
+  // a vector of `blocks` blocks of every contact node -> this rank's part, and back
+  std::vector<real> local_part(const std::vector<real>& whole, int blocks) const;
+  std::vector<real> whole(const std::vector<real>& local, int blocks) const;
+  std::vector<std::uint8_t> whole(const std::vector<std::uint8_t>& local) const;
   // entries of a 3D vector (extension, guess, interior): 3N, or 3 x the
   // rank's slab nodes when distributed
   index full_size() const;
@@ -83,8 +95,7 @@ class SteklovPoincare {
   const Problem& problem() const { return P_; }
 
   // scatter contact values into / gather them from a full SoA grid vector
-  // (distributed: scatter writes this rank's contact nodes into its slab,
-  // gather returns every rank's on all ranks)
+  // (this rank's contact nodes and rows)
   void scatter(const real* vc, real* full) const;
   void gather(const real* full, real* vc) const;
 
@@ -106,7 +117,7 @@ class SteklovPoincare {
   std::unique_ptr<DistributedElasticity> Kd_;  // faces x0
   std::unique_ptr<DistributedMultigrid> dmg_;  // K_ii, faces x0 | z0
   index c_begin_ = 0, c_end_ = 0;              // this rank's contact nodes
-  std::vector<int> counts_, displs_;           // every rank's contact nodes (allgather)
+  std::vector<int> counts_, displs_;           // every rank's contact nodes (whole())
   mutable CGWorkspace ws_;  // scratch
   mutable std::vector<real> w_, t_, z_;
 };

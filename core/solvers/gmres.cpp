@@ -5,6 +5,7 @@
 #include <string>
 
 #include "kernels/vector_ops.hpp"
+#include "core/parallel/comm.hpp"
 
 namespace tresca {
 
@@ -21,7 +22,9 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
   auto h = [&](int i, int j) -> real& { return H[i * m + j]; };
 
   SolveStats st;
-  st.rhs_norm = norm2(n, b);
+  // local sums -> over all ranks (identity on one rank)
+  auto norm = [&](const real* v) { return std::sqrt(opt.comm ? opt.comm->sum(dot(n, v, v)) : dot(n, v, v)); };
+  st.rhs_norm = norm(b);
   const real target = std::max(opt.rtol * st.rhs_norm, opt.atol);
   if (opt.zero_initial_guess) fill<real>(n, 0, x);
   bool first = true;
@@ -36,7 +39,7 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
       copy(n, b, r);
       axpy(n, -1, w.data(), r);
     }
-    const real beta = norm2(n, r);
+    const real beta = norm(r);
     if (first) st.initial_residual = beta;
     first = false;
     st.residual = beta;
@@ -71,9 +74,10 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
       }
       for (int i = 0; i <= j; ++i) {
         h(i, j) = dot(n, w.data(), V[i].data());
+        if (opt.comm) h(i, j) = opt.comm->sum(h(i, j));
         axpy(n, -h(i, j), V[i].data(), w.data());
       }
-      const real hn = norm2(n, w.data());  // ||w||: the next basis vector is w / hn
+      const real hn = norm(w.data());  // ||w||: the next basis vector is w / hn
       h(j + 1, j) = hn;
       if (!std::isfinite(hn)) {
         st.reason = SolveReason::non_finite;
@@ -120,7 +124,7 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
       st.operator_applications += 1;
       copy(n, b, r);
       axpy(n, -1, w.data(), r);
-      st.residual = norm2(n, r);
+      st.residual = norm(r);
       if (st.residual > target) st.reason = SolveReason::breakdown;
       return st;
     }
