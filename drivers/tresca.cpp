@@ -403,7 +403,7 @@ int main(int argc, char** argv) {
     if (comm.distributed()) {
       const CommCounters& c = comm_counters();
       std::printf("communication (rank 0, whole run): %lld messages, %.1f MB point-to-point, %lld allreduces, "
-                  "%lld allgathers\n", c.messages, c.bytes / 1e6, c.allreduces, c.allgathers);
+                  "%lld other collectives\n", c.messages, c.bytes / 1e6, c.allreduces, c.collectives);
     }
     if (profile) std::printf("\nkernel profile (%s, %d threads)\n%s", build_info().c_str(), threads,
                              profile_table(R.times.total).c_str());

@@ -77,7 +77,7 @@ int project(const Args& a) {
   // a Newton step with the counts measured at levels 10-12 (--outer per
   // step, --inner per S apply; perf/RESULTS.md §0g)
   const double outer = a.real_value("--outer", 3.5), inner = a.real_value("--inner", 6);
-  const CommVolume st = newton_step_comm(H->grids, px, py, MGOptions{}.degree, outer, inner, spec.contact_nodes());
+  const CommVolume st = newton_step_comm(H->grids, px, py, MGOptions{}.degree, outer, inner);
   const double t_step = ((outer + 2) * (inner * (1 + cycle) + 2.0 / double(g.nz())) + outer * cycle) * t_apply;
   std::printf("Newton step (%.1f outer, %.0f inner per S apply): %.0f messages %10.4g bytes %.0f allreduces -> %.3g s "
               "against %.3g s of compute (%.1f %%)\n",

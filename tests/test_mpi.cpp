@@ -271,16 +271,19 @@ TEST(CommModel, BoxHalosAndTheRankGrid) {
   const CommVolume v = apply_halo(g, 4, 2);
   EXPECT_EQ(v.messages, 8);
   EXPECT_DOUBLE_EQ(v.bytes, 24.0 * 33 * (2 * 33.0 / 2 + 2 * 65.0 / 4 + 4));
-  // a Newton step: nothing on one rank; (outer + 2) S applies and outer
-  // V-cycles of K + B, each with a gather of the contact vectors
+  // a Newton step: nothing on one rank; per outer iteration an S apply, a
+  // V-cycle of K + B and 2 allreduces; two more S applies, 10 scalar
+  // allreduces and the allreduce of the bottom-plane block per step
   const std::vector<GridDims> grids = {g, test::prism(32, 16, 16), test::prism(16, 8, 8)};
-  EXPECT_EQ(newton_step_comm(grids, 1, 1, 3, 4, 6, 2112).messages, 0);
-  const CommVolume s0 = newton_step_comm(grids, 1, 4, 3, 0, 6, 2112), s3 = newton_step_comm(grids, 1, 4, 3, 3, 6, 2112);
+  EXPECT_EQ(newton_step_comm(grids, 1, 1, 3, 4, 6).messages, 0);
+  const CommVolume s0 = newton_step_comm(grids, 1, 4, 3, 0, 6), s3 = newton_step_comm(grids, 1, 4, 3, 3, 6);
   const CommVolume s_apply = mgcg_iteration(grids, 1, 4, 3) * 6.0 + apply_halo(g, 1, 4) * 2.0;
-  EXPECT_DOUBLE_EQ(s0.bytes, 2 * (s_apply.bytes + contact_allgather(2112, 4).bytes));
-  EXPECT_DOUBLE_EQ(s3.messages - s0.messages,
-                   3 * (s_apply.messages + vcycle_halo(grids, 1, 4, 3).messages + 2 * contact_allgather(2112, 4).messages));
-  EXPECT_DOUBLE_EQ(contact_allgather(2112, 4).bytes, 3.0 * 2112 / 4 * 8 * 3);
+  const CommVolume plane = allreduce_volume(4.0 * 65 * 33, 4);
+  EXPECT_DOUBLE_EQ(s0.bytes, 2 * s_apply.bytes + plane.bytes);
+  EXPECT_DOUBLE_EQ(s0.allreduces, 2 * s_apply.allreduces + 10 + 1);
+  EXPECT_DOUBLE_EQ(s3.messages - s0.messages, 3 * (s_apply.messages + vcycle_halo(grids, 1, 4, 3).messages));
+  EXPECT_DOUBLE_EQ(s3.allreduces - s0.allreduces, 3 * (s_apply.allreduces + 2));
+  EXPECT_DOUBLE_EQ(plane.bytes, 2.0 * 3 / 4 * 4 * 65 * 33 * 8);
   NetworkModel net{1e-6, 1e9};
   EXPECT_DOUBLE_EQ(net.seconds({10, 1e6, 2}, 8), 10e-6 + 2 * 3e-6 + 1e-3);
 }

@@ -66,7 +66,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   if (Comm::world().distributed()) {  // what rank 0 sent over the whole run (comm.hpp)
     const CommCounters& c = comm_counters();
     j["communication_rank0"] = {{"messages", c.messages}, {"bytes", c.bytes}, {"allreduces", c.allreduces},
-                                {"allgathers", c.allgathers}};
+                                {"collectives", c.collectives}};
   }
   j["build"] = build_info();
   j["mg_precision"] = to_string(opt.mg.precision);

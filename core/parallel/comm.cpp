@@ -92,7 +92,7 @@ void Comm::allgather(real* v, const std::vector<int>& counts, const std::vector<
 #ifdef TRESCA_HAVE_MPI
   if (size_ > 1) {
     MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, v, counts.data(), displs.data(), MPI_DOUBLE, MPI_COMM_WORLD);
-    comm_counters().allgathers += 1;
+    comm_counters().collectives += 1;
     comm_counters().bytes += double(counts[rank_]) * sizeof(real) * (size_ - 1);
   }
 #else
@@ -106,7 +106,7 @@ void Comm::broadcast(real* v, int n, int root) const {
 #ifdef TRESCA_HAVE_MPI
   if (size_ > 1) {
     MPI_Bcast(v, n, MPI_DOUBLE, root, MPI_COMM_WORLD);
-    comm_counters().allgathers += 1;  // a collective of the same kind
+    comm_counters().collectives += 1;
     if (rank_ == root) comm_counters().bytes += double(n) * sizeof(real) * (size_ - 1);
   }
 #else

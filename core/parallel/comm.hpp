@@ -37,11 +37,12 @@ class Comm {
   friend class MpiSession;
 };
 
-// What this rank has sent since the start (or the last reset): point-to-point
-// messages and bytes (ghost exchanges, row fetches counted per peer),
-// allreduces and allgathers. Counted where they are posted; one rank: zeros.
+// What this rank has sent since the start: point-to-point messages and
+// bytes (ghost exchanges, row fetches counted per peer), allreduces, and
+// other collectives (allgathers, broadcasts). Counted where they are posted;
+// one rank: zeros.
 struct CommCounters {
-  long long messages = 0, allreduces = 0, allgathers = 0;
+  long long messages = 0, allreduces = 0, collectives = 0;
   double bytes = 0;
 };
 CommCounters& comm_counters();

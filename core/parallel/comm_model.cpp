@@ -48,22 +48,23 @@ CommVolume mgcg_iteration(const std::vector<GridDims>& grids, int px, int py, in
   return v;
 }
 
-CommVolume contact_allgather(index contact_nodes, int ranks) {
+CommVolume allreduce_volume(double n, int ranks) {
   if (ranks <= 1) return {};
-  const double share = 3.0 * double(contact_nodes) / ranks * sizeof(double);
-  return {double(ranks - 1), share * (ranks - 1), 0};
+  return {0, 2.0 * (ranks - 1) / ranks * n * sizeof(double), 1};
 }
 
-CommVolume newton_step_comm(const std::vector<GridDims>& grids, int px, int py, int degree, double outer, double inner,
-                            index contact_nodes) {
+CommVolume newton_step_comm(const std::vector<GridDims>& grids, int px, int py, int degree, double outer, double inner) {
   const int P = px * py;
+  if (P <= 1) return {};
+  const GridDims& g = grids.front();
   CommVolume s_apply = mgcg_iteration(grids, px, py, degree) * inner;
-  s_apply += apply_halo(grids.front(), px, py) * 2.0;
-  s_apply += contact_allgather(contact_nodes, P);
-  CommVolume pc = vcycle_halo(grids, px, py, degree);
-  pc += contact_allgather(contact_nodes, P);
-  CommVolume step = s_apply * (outer + 2);
-  step += pc * outer;
+  s_apply += apply_halo(g, px, py) * 2.0;
+  CommVolume it = s_apply + vcycle_halo(grids, px, py, degree);
+  it.allreduces += 2;
+  CommVolume step = it * outer;
+  step += s_apply * 2.0;
+  step.allreduces += 10;
+  step += allreduce_volume(4.0 * double(g.nx() * g.ny()), P);
   return step;
 }
 

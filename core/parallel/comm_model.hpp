@@ -50,16 +50,17 @@ CommVolume vcycle_halo(const std::vector<GridDims>& grids, int px, int py, int d
 // one MG-CG iteration: an apply, a V-cycle, two allreduces
 CommVolume mgcg_iteration(const std::vector<GridDims>& grids, int px, int py, int degree);
 
-// the contact vectors (3p doubles) gathered on every rank: ring allgather,
-// P - 1 messages of 3p/P values per rank
-CommVolume contact_allgather(index contact_nodes, int ranks);
-// one Newton step of the contact solver (steklov.hpp, semismooth.hpp): `outer`
-// boundary Krylov iterations, each an S apply (an inner MG-CG solve of
-// `inner` iterations, two plane applies, a contact allgather) and a K + B
-// V-cycle with its allgather; plus two more S applies (the known
-// increments and the bookkeeping S du)
-CommVolume newton_step_comm(const std::vector<GridDims>& grids, int px, int py, int degree, double outer, double inner,
-                            index contact_nodes);
+// an allreduce of n doubles over P ranks (reduce-scatter + allgather:
+// 2 (P - 1) / P n doubles sent per rank), counted as one allreduce
+CommVolume allreduce_volume(double n, int ranks);
+// one Newton step of the contact solver (steklov.hpp, semismooth.hpp) with
+// the contact vectors distributed like the grid: `outer` boundary Krylov
+// iterations, each an S apply (an inner MG-CG solve of `inner`
+// iterations and two plane applies), a K + B V-cycle and 2 allreduces;
+// plus two more S applies (the known increments and the bookkeeping S du),
+// 10 scalar allreduces (norms, counts, the known-increment flag) and the
+// allreduce of the K + B block over the bottom plane (4 nx ny doubles)
+CommVolume newton_step_comm(const std::vector<GridDims>& grids, int px, int py, int degree, double outer, double inner);
 
 // the most nearly square px x py = ranks with px / py close to nx / ny
 void rank_grid(const GridDims& g, int ranks, int& px, int& py);
