@@ -116,6 +116,20 @@ void Comm::broadcast(real* v, int n, int root) const {
 #endif
 }
 
+void Comm::broadcast(float* v, int n, int root) const {
+#ifdef TRESCA_HAVE_MPI
+  if (size_ > 1) {
+    MPI_Bcast(v, n, MPI_FLOAT, root, MPI_COMM_WORLD);
+    comm_counters().collectives += 1;
+    if (rank_ == root) comm_counters().bytes += double(n) * sizeof(float) * (size_ - 1);
+  }
+#else
+  (void)v;
+  (void)n;
+  (void)root;
+#endif
+}
+
 int Comm::ranks_on_this_host() const {
 #ifdef TRESCA_HAVE_MPI
   if (size_ > 1) {

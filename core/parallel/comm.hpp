@@ -29,6 +29,7 @@ class Comm {
   void barrier() const;
   // v[0..n) of rank `root` to every rank
   void broadcast(real* v, int n, int root = 0) const;
+  void broadcast(float* v, int n, int root = 0) const;
   // how many ranks run on this rank's machine (MPI_COMM_TYPE_SHARED)
   int ranks_on_this_host() const;
 

@@ -117,12 +117,16 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
       f.restrict_t = f.prolong_t = T;
       continue;
     }
-    // restriction onto the coarse local rows [c0, c1): the fine rows of their lists
+    if (!c.distributed) f.prolong_t = slice_rows(T, f0, f1, 0, c.g.ny());  // the coarse vector is whole here
+    // restriction onto the coarse local rows [c0, c1): the fine rows of their
+    // lists (onto a replicated level: all of them, on rank 0 alone)
     index a = f.g.ny(), b = 0;
     for (index j = c0; j < c1; ++j)
       for (index k = Y.tstart[j]; k < Y.tstart[j + 1]; ++k) a = std::min(a, Y.tf[k]), b = std::max(b, Y.tf[k] + 1);
     if (b - a < 2) b = std::min(f.g.ny(), a + 2), a = b - 2;
+    if (!c.distributed && comm.rank() != 0) a = b = 0;
     f.fetch_fine = std::make_unique<RowFetch>(f.slab, a, b, comm);
+    if (a == b) continue;  // (prolong_t below: the coarse vector is whole on every rank)
     f.restrict_t = slice_rows(T, a, b, c0, c1);
     // prolongation onto the fine local rows [f0, f1): the coarse rows they interpolate from
     index ca = c.g.ny(), cb = 0;
@@ -132,8 +136,6 @@ DistributedMultigrid::DistributedMultigrid(const GridDims& fine, unsigned faces,
     if (c.distributed) {
       f.fetch_coarse = std::make_unique<RowFetch>(c.slab, ca, cb, comm);
       f.prolong_t = slice_rows(T, f0, f1, ca, cb);
-    } else {
-      f.prolong_t = slice_rows(T, f0, f1, 0, c.g.ny());  // the coarse vector is whole here
     }
   }
   for (size_t l = 0; l + 1 < levels_.size(); ++l) {
@@ -241,8 +243,8 @@ void DistributedMultigrid::build_work() {
     Work<T>& w = lv->work<T>();
     if (!lv->distributed) w.k = stencil_in_precision<T>(lv->Ar.stencil());
     for (auto* v : {&w.x, &w.b, &w.r, &w.d}) v->resize(lv->n);
-    if (lv->fetch_fine) w.fine_rows.resize(3 * lv->fetch_fine->box().nodes());
-    if (lv->fetch_coarse) w.coarse_rows.resize(3 * lv->fetch_coarse->box().nodes());
+    if (lv->fetch_fine) w.fine_rows.resize(lv->fetch_fine->size());
+    if (lv->fetch_coarse) w.coarse_rows.resize(lv->fetch_coarse->size());
     w.xp = w.x.data();
     w.bp = w.b.data();
   }
@@ -311,14 +313,10 @@ void DistributedMultigrid::vcycle(int l) const {
   const Level& lv = *levels_[l];
   const Work<T>& w = lv.work<T>();
   if (l + 1 == int(levels_.size())) {
-    // solved on rank 0 (every rank holds the same right-hand side), the
-    // answer broadcast
+    // (replicated levels run on rank 0 alone when there are several ranks)
     ScopedTimer t(Kernel::coarse_solve);
-    if (comm_.rank() == 0) {
-      for (index i = 0; i < lv.n; ++i) cb_[i] = real(w.bp[i]);
-      cx_ = coarse_.solve(cb_);
-    }
-    comm_.broadcast(cx_.data(), int(lv.n));
+    for (index i = 0; i < lv.n; ++i) cb_[i] = real(w.bp[i]);
+    cx_ = coarse_.solve(cb_);
     for (index i = 0; i < lv.n; ++i) w.xp[i] = T(cx_[i]);
     return;
   }
@@ -333,11 +331,19 @@ void DistributedMultigrid::vcycle(int l) const {
       lv.fetch_fine->fetch<T>(w.r.data(), w.fine_rows.data());
       fine = w.fine_rows.data();
     }
-    restrict_to_coarse<T>(lv.restrict_t, 3, fine, cw.b.data());
-    zero_constrained<T>(c.slab.local, c.slab.local_faces(faces_), cw.b.data());
-    if (c.distributed) c.Ad->zero_ghosts(cw.b.data());
+    if (!agglomerated(l + 1) || comm_.rank() == 0) {
+      restrict_to_coarse<T>(lv.restrict_t, 3, fine, cw.b.data());
+      zero_constrained<T>(c.slab.local, c.slab.local_faces(faces_), cw.b.data());
+      if (c.distributed) c.Ad->zero_ghosts(cw.b.data());
+    }
   }
-  vcycle<T>(l + 1);
+  if (agglomerated(l + 1)) {
+    // the coarse levels on rank 0 alone; their correction to every rank
+    if (comm_.rank() == 0) vcycle<T>(l + 1);
+    comm_.broadcast(cw.x.data(), int(c.n));
+  } else {
+    vcycle<T>(l + 1);
+  }
   {
     ScopedTimer t(Kernel::prolongate, double(lv.n) * in_precision<T>(kProlongateCost));
     const T* coarse = cw.x.data();
@@ -353,18 +359,25 @@ void DistributedMultigrid::vcycle(int l) const {
 
 void DistributedMultigrid::apply(const real* r, real* z) const {
   const Level& f = *levels_[0];
+  // all levels replicated on several ranks: rank 0 alone, the answer to all
+  const bool alone = agglomerated(0);
   if (opt_.precision == Precision::double_precision) {
     f.wd.bp = r;
     f.wd.xp = z;
-    vcycle<real>(0);
+    if (!alone || comm_.rank() == 0) vcycle<real>(0);
     f.wd.bp = f.wd.b.data();
     f.wd.xp = f.wd.x.data();
   } else {
     convert<float>(f.n, r, f.ws.b.data());
-    vcycle<float>(0);
+    if (!alone || comm_.rank() == 0) vcycle<float>(0);
     convert<double>(f.n, f.ws.x.data(), z);
   }
+  if (alone) comm_.broadcast(z, int(f.n));
   if (f.distributed) f.Ad->zero_ghosts(z);
+}
+
+bool DistributedMultigrid::agglomerated(int l) const {
+  return comm_.distributed() && !levels_[l]->distributed && (l == 0 || levels_[l - 1]->distributed);
 }
 
 double DistributedMultigrid::cycle_work() const {
@@ -378,7 +391,7 @@ std::string DistributedMultigrid::describe() const {
   os << levels_.size() << " levels:";
   for (const auto& lv : levels_) os << " " << lv->g.ex << "x" << lv->g.ey << "x" << lv->g.ez << (lv->distributed ? "(d)" : "");
   os << " (" << to_string(opt_.precision) << " precision; (d): distributed over " << comm_.size()
-     << " ranks, others replicated)";
+     << " ranks, the others agglomerated on rank 0)";
   return os.str();
 }
 

@@ -10,13 +10,12 @@
 //   (distributed_elasticity.hpp);
 // * a level with fewer than 2 node rows per rank or fewer than
 //   `min_nodes_per_rank` nodes per rank, and every coarser one, is
-//   replicated: every rank holds all of it and computes the same thing
-//   (agglomeration onto all ranks, no messages inside); the coarsest is
-//   factorised and solved by rank 0 alone, its answer broadcast;
+//   agglomerated onto rank 0: the fine residual is gathered there, rank 0
+//   alone runs the coarse levels (no messages inside) down to the coarsest
+//   (factorised and solved there), and broadcasts the correction;
 // * transfers between distributed levels fetch the rows that neighbours
 //   own (row_fetch.hpp): the coarse rows a fine slab interpolates from, the
-//   fine rows a coarse slab restricts from; at the first replicated level
-//   the fine residual is gathered whole.
+//   fine rows a coarse slab restricts from.
 //
 // One rank: every level replicated, i.e. multigrid.hpp's V-cycle (up to the
 // Lanczos start vector, here a hash of the global index so that it does
@@ -85,6 +84,9 @@ class DistributedMultigrid : public LinearOperator {
   void smooth(int l, bool zero_guess) const;
   template <class T>
   void vcycle(int l) const;
+  // level l is the first replicated level on several ranks: it and the
+  // coarser ones are computed by rank 0 alone
+  bool agglomerated(int l) const;
 
   MGOptions opt_;
   const Comm& comm_;

@@ -19,9 +19,12 @@ namespace tresca {
 class RowFetch {
  public:
   // s: this rank's slab of the distributed vector; rows [a, b) wanted here
+  // (a = b = 0: none, the rank only sends; e.g. a gather onto one rank)
   RowFetch(const Slab& s, index a, index b, const Comm& comm = Comm::world());
   // the box of the fetched rows: the global grid's x and z, rows [a, b)
   const GridDims& box() const { return box_; }
+  // entries of the fetched vector (3 components; 0 when nothing is wanted)
+  index size() const { return a_ == b_ ? 0 : 3 * box_.nodes(); }
   index first_row() const { return a_; }
   // out (3 * box().nodes()) := rows [a, b) of the distributed vector whose
   // local part (slab's local box) is `local`
