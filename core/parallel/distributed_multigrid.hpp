@@ -17,7 +17,7 @@
 //   own (row_fetch.hpp): the coarse rows a fine slab interpolates from, the
 //   fine rows a coarse slab restricts from.
 //
-// One rank: every level replicated, i.e. multigrid.hpp's V-cycle (up to the
+// One rank: every level whole, i.e. multigrid.hpp's V-cycle (up to the
 // Lanczos start vector, here a hash of the global index so that it does
 // not depend on the rank count).
 #pragma once
@@ -84,8 +84,8 @@ class DistributedMultigrid : public LinearOperator {
   void smooth(int l, bool zero_guess) const;
   template <class T>
   void vcycle(int l) const;
-  // level l is the first replicated level on several ranks: it and the
-  // coarser ones are computed by rank 0 alone
+  // level l is the first whole (not distributed) level on several ranks:
+  // it and the coarser ones are computed by rank 0 alone
   bool agglomerated(int l) const;
 
   MGOptions opt_;

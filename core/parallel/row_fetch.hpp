@@ -2,7 +2,7 @@
 // onto one rank: the multigrid transfers between non-nested levels need
 // rows that neighbouring ranks own (the coarse rows a fine slab
 // interpolates from, the fine rows a coarse slab restricts from), and the
-// first replicated coarse level needs all of them.
+// rank that runs the agglomerated coarse levels needs all of them.
 //
 // Each rank asks for one contiguous range [a, b) of the global rows; the
 // ranges are exchanged once (MPI_Allgather) when the fetch is set up, and
