@@ -176,10 +176,12 @@ double SteklovPoincare::apply_work(long long inner_iterations) const {
 SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior,
                                            const real* guess) const {
   // the load on this rank's rows (all of it on one rank)
-  std::vector<real> load(P_.load);
+  std::vector<real> load;
   if (dmg_) {
     load.assign(full_size(), 0);
     global_to_local(slab(), P_.load.data(), load.data());
+  } else {
+    load = P_.load;
   }
   std::vector<real> li(load);
   zero_constrained(box(), dmg_ ? slab().local_faces(P_.interior_faces) : P_.interior_faces, li.data());
