@@ -396,8 +396,8 @@ int main(int argc, char** argv) {
     if (N.outer_limit_hits > 0)
       std::printf("note: %d Newton steps were taken with an outer CG stopped at its iteration limit\n",
                   N.outer_limit_hits);
-    std::printf("work: %.1f fine-grid matvec equivalents per Newton step; peak memory %.2f GB\n",
-                R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9);
+    std::printf("work: %.1f fine-grid matvec equivalents per Newton step; peak memory %.2f GB%s\n",
+                R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9, comm.distributed() ? " (largest rank)" : "");
     std::printf("times [s]: nested %.3f, setup %.3f, condense %.3f, solve %.3f, recover %.3f, total %.3f\n",
                 R.times.nested, R.times.setup, R.times.condense, R.times.solve, R.times.recover, R.times.total);
     if (comm.distributed()) {
