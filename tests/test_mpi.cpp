@@ -99,7 +99,9 @@ TEST(DistributedElasticity, ExchangeFillsTheGhostRowsAndCountsAsTheModelSays) {
   EXPECT_EQ(K.counts().bytes, model.bytes);
   EXPECT_EQ(K.counts().exchanges, world().size() > 1 ? 1 : 0);
   // an interior slab is a box decomposition 1 x P
-  if (s.lo && s.hi) EXPECT_EQ(apply_halo(g, 1, world().size()).bytes, model.bytes);
+  if (s.lo && s.hi) {
+    EXPECT_EQ(apply_halo(g, 1, world().size()).bytes, model.bytes);
+  }
 }
 
 TEST(DistributedCG, SameIterationsAndSolutionAsTheWholeGrid) {
@@ -137,7 +139,9 @@ TEST(DistributedCG, SameIterationsAndSolutionAsTheWholeGrid) {
   ASSERT_TRUE(sd.ok());
   EXPECT_NEAR(sd.iterations, sg.iterations, 1);  // the ranks' partial sums round differently
   EXPECT_LE(max_owned_diff(s, u, ug), 1e-9 * test::max_abs(ug));
-  if (world().size() == 1) EXPECT_EQ(sd.iterations, sg.iterations);
+  if (world().size() == 1) {
+    EXPECT_EQ(sd.iterations, sg.iterations);
+  }
 }
 
 TEST(RowFetch, AnyRangeOfRowsFromTheirOwners) {
@@ -175,7 +179,9 @@ TEST(DistributedMultigrid, CGMatchesTheWholeGridMultigrid) {
     const Multigrid mg(g, kFaces, 2.1e9, 0.277, mo);
     const DistributedMultigrid dmg(g, kFaces, 2.1e9, 0.277, mo, world(), 64);
     ASSERT_EQ(dmg.num_levels(), mg.num_levels());
-    if (world().size() > 1) EXPECT_GE(dmg.distributed_levels(), 2) << dmg.describe();
+    if (world().size() > 1) {
+      EXPECT_GE(dmg.distributed_levels(), 2) << dmg.describe();
+    }
     for (int l = 0; l + 1 < mg.num_levels(); ++l) EXPECT_NEAR(dmg.lmax(l), 0, 1e9);  // finite
     std::vector<real> bg = test::random_vector(3 * g.nodes(), 21);
     zero_constrained(g, kFaces, bg.data());
@@ -217,7 +223,9 @@ TEST(DistributedMultigrid, BottomBlockCGMatchesTheWholeGridMultigrid) {
   mg.set_bottom_block(B);
   DistributedMultigrid dmg(g, kFaceX0, 2.1e9, 0.277, mo, world(), 64);
   dmg.set_bottom_block(B);
-  if (world().size() > 1) ASSERT_TRUE(dmg.fine_distributed());
+  if (world().size() > 1) {
+    ASSERT_TRUE(dmg.fine_distributed());
+  }
   std::vector<real> bg = test::random_vector(3 * g.nodes(), 9);
   zero_constrained(g, unsigned(kFaceX0), bg.data());
   CGOptions o;
