@@ -32,8 +32,18 @@ bool mpi_enabled() {
 #endif
 }
 
+namespace {
+bool session_started = false;
+// started by an MPI launcher (mpirun / mpiexec, with any rank count)
+bool launched_by_mpi() { return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK"); }
+}  // namespace
+
 MpiSession::MpiSession(int& argc, char**& argv) {
 #ifdef TRESCA_HAVE_MPI
+  // a plain run is one rank without MPI: Open MPI's singleton start-up
+  // (it spawns a daemon) would cost 0.4 s per run
+  if (!launched_by_mpi()) return;
+  session_started = true;
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   if (provided < MPI_THREAD_FUNNELED) throw std::runtime_error("MPI does not provide MPI_THREAD_FUNNELED");
@@ -48,7 +58,7 @@ MpiSession::MpiSession(int& argc, char**& argv) {
 
 MpiSession::~MpiSession() {
 #ifdef TRESCA_HAVE_MPI
-  MPI_Finalize();
+  if (session_started) MPI_Finalize();
 #endif
 }
 

@@ -48,7 +48,9 @@ struct CommCounters {
 };
 CommCounters& comm_counters();
 
-// MPI_Init_thread / MPI_Finalize around main (RAII). Without MPI: nothing.
+// MPI_Init_thread / MPI_Finalize around main (RAII), when an MPI launcher
+// (mpirun, mpiexec) started the program; otherwise, and without MPI,
+// nothing: one rank.
 class MpiSession {
  public:
   MpiSession(int& argc, char**& argv);
