@@ -95,6 +95,18 @@ const PaperRow* paper_row(int level) {
 
 }  // namespace
 
+namespace {
+// The body and its contact face as one step of a .pvd collection: a .vtu,
+// or on a mesh split over the ranks a .pvtu with one piece per rank (a mesh
+// too small to split is whole on every rank: rank 0 writes it).
+PvdStep write_step(OutputSet& out, double time, const std::string& vtu, const Problem& P, const Slab& rows,
+                   const std::vector<real>& u_full, const ContactFields& cf, VtkFormat format) {
+  if (rows.ranks > 1) return {time, {path_stem(vtu) + ".pvtu", write_pvtu(out, vtu, P, rows, u_full, cf, format)}};
+  if (Comm::world().rank() != 0) return {time, {vtu, vtu_companion(vtu)}};
+  return {time, {vtu, write_vtu(out, vtu, P, u_full, cf, format)}};
+}
+}  // namespace
+
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
   // Under mpirun with several ranks every rank runs this main: the 3D work is
@@ -206,9 +218,6 @@ int main(int argc, char** argv) {
       outputs.push_back({vtu_companion(vtk_path), "--vtk's contact file"});
     }
     every_iteration = a.has("--vtk-every-iteration");
-    if (!vtk_path.empty() && comm.distributed() && (!table.empty() || every_iteration))
-      throw std::invalid_argument("--vtk with --table or --vtk-every-iteration on " + std::to_string(comm.size()) +
-                                  " MPI ranks: not written yet (one run's .pvtu is); run it on one rank");
     if (every_iteration && (vtk_path.empty() || !table.empty()))
       throw std::invalid_argument("--vtk-every-iteration needs --vtk FILE.vtu (and no --table)");
     if (every_iteration) {
@@ -289,7 +298,7 @@ int main(int argc, char** argv) {
           const std::string v = vtu_step_name(vtk_path, "_level" + std::to_string(L));
           const ContactFields cf{&R.newton.u, &R.newton.lambda, &R.report.r, &R.report.status, &R.contact.phi,
                                  &R.contact.gap};
-          steps.push_back({double(L), {v, write_vtu(out, v, *R.problem, R.u_full, cf, vtk_format)}});
+          steps.push_back(write_step(out, double(L), v, *R.problem, R.slab, R.u_full, cf, vtk_format));
         }
         const PaperRow* pr = paper_row(L);
         char pbuf[128] = "        -         -         -     -";
@@ -304,7 +313,9 @@ int main(int argc, char** argv) {
       }
       try {
         if (!json_path.empty()) write_text(out, json_path, json_text(rows));
-        if (!vtk_path.empty()) write_pvd(out, pvd_name(vtk_path), steps);
+        if (!vtk_path.empty() && comm.rank() == 0) write_pvd(out, pvd_name(vtk_path), steps);
+        out.finish();
+        comm.barrier();  // every rank's pieces complete on disk before any is published
         out.publish();
       } catch (const std::exception& e) {
         std::fprintf(stderr, "tresca: error: %s\n", e.what());
@@ -340,7 +351,7 @@ int main(int argc, char** argv) {
           const NewtonProgress& pr = *it.progress;
           const ContactFields cf{pr.u, pr.lambda, pr.r, pr.status, pr.phi, it.gap};
           const std::string v = vtu_step_name(vtk_path, "_it" + std::to_string(it.step));
-          steps.push_back({double(it.step), {v, write_vtu(out, v, *it.problem, *it.u_full, cf, vtk_format)}});
+          steps.push_back(write_step(out, double(it.step), v, *it.problem, *it.slab, *it.u_full, cf, vtk_format));
           out.finish();
         } catch (const std::exception& e) {
           iterate_error = e.what();
@@ -411,21 +422,20 @@ int main(int argc, char** argv) {
       const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.contact.phi, &R.contact.gap};
       // all of the run's outputs, or none of them (output.hpp: OutputSet)
       if (!iterate_error.empty()) throw std::runtime_error(iterate_error);
-      if (every_iteration) write_pvd(out, pvd_name(vtk_path), steps);
+      if (every_iteration && comm.rank() == 0) write_pvd(out, pvd_name(vtk_path), steps);
       if (!json_path.empty()) write_text(out, json_path, json_text(run_summary(spec, R, threads, opt)));
       if (!csv_path.empty()) write_contact_csv(out, csv_path, *R.problem, cf);
-      std::string first = vtk_path, second;
-      if (!vtk_path.empty() && comm.distributed()) {
-        second = write_pvtu(out, vtk_path, *R.problem, R.slab, R.u_full, cf, vtk_format);
-        first = path_stem(vtk_path) + ".pvtu (with " + std::to_string(comm.size()) + " pieces " +
-                pvtu_piece_name(vtk_path, 0) + ", ...)";
-        out.finish();
-        comm.barrier();  // every rank's piece complete on disk before any is published
-      } else if (!vtk_path.empty()) {
-        second = write_vtu(out, vtk_path, *R.problem, R.u_full, cf, vtk_format);
-      }
+      std::vector<std::string> wrote;
+      if (!vtk_path.empty()) wrote = write_step(out, 0, vtk_path, *R.problem, R.slab, R.u_full, cf, vtk_format).files;
+      out.finish();
+      comm.barrier();  // every rank's pieces complete on disk before any is published
       out.publish();
-      if (!vtk_path.empty() && !quiet) std::printf("wrote %s and %s\n", first.c_str(), second.c_str());
+      if (!vtk_path.empty() && !quiet)
+        std::printf("wrote %s%s and %s\n", wrote[0].c_str(),
+                    R.slab.ranks > 1 ? (" (with " + std::to_string(R.slab.ranks) + " pieces " +
+                                        pvtu_piece_name(vtk_path, 0) + ", ...)").c_str()
+                                     : "",
+                    wrote[1].c_str());
     } catch (const std::exception& e) {
       std::fprintf(stderr, "tresca: error: %s\n", e.what());
       return 3;

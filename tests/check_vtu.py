@@ -15,8 +15,8 @@ Debian python3-vtk9) and checks them against the run's contact CSV and JSON:
   rounding), contact_status equal to the CSV's contact/stick columns;
 - --ascii: the same run written as text holds the same arrays (to its 12
   digits), and the binary files are at least R times smaller;
-- --pvd: a collection of N steps, the body and its contact face each, all
-  files read by VTK;
+- --pvd: a collection of N steps, the body (.vtu, or .pvtu and its pieces)
+  and its contact face each, all files read by VTK;
 - --pvtu: ParaView's parallel file of a run on several ranks, read whole by
   VTK's parallel reader: as many hexahedra as the one-rank file B.vtu, each
   point's displacement, contact force and status equal to B's at the same
@@ -40,7 +40,8 @@ def fail(msg):
 
 
 def read(path):
-    r = vtk.vtkXMLUnstructuredGridReader()
+    # a .pvtu (the pieces of a run on several ranks) with VTK's parallel reader
+    r = vtk.vtkXMLPUnstructuredGridReader() if path.endswith(".pvtu") else vtk.vtkXMLUnstructuredGridReader()
     r.SetFileName(path)
     r.Update()
     g = r.GetOutput()

@@ -96,12 +96,24 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   if (opt.phase_done) opt.phase_done("setup (mesh, operators, multigrid)", t1 - t0s);
   if (opt.iterate_done) {
     // each iterate's body: E u from one S apply, plus K_ii^{-1} l_i
-    newton.progress = [&, shown = newton.progress, step = 0](const NewtonProgress& pr) mutable {
+    const Slab rows = S.distributed() ? S.slab() : make_slab(R.problem->grid, 0, 1);
+    newton.progress = [&, rows, shown = newton.progress, step = 0](const NewtonProgress& pr) mutable {
       if (shown) shown(pr);
       std::vector<real> Su(pr.u->size()), u_full(S.full_size());
       S.apply(pr.u->data(), Su.data(), 1e-8, u_full.data());
       axpy(index(u_full.size()), 1, R.interior_load.data(), u_full.data());
-      opt.iterate_done(Iterate{R.problem.get(), step++, &pr, &u_full, &R.contact.gap});
+      S.exchange_ghosts(u_full.data());
+      // every contact node's values (several ranks: gathered)
+      const std::vector<real> u = S.whole(*pr.u, 3), lambda = S.whole(*pr.lambda, 1), r = S.whole(*pr.r, 3),
+                              phi = S.whole(*pr.phi, 1);
+      const std::vector<std::uint8_t> status = S.whole(*pr.status);
+      NewtonProgress whole = pr;
+      whole.u = &u;
+      whole.lambda = &lambda;
+      whole.r = &r;
+      whole.phi = &phi;
+      whole.status = &status;
+      opt.iterate_done(Iterate{R.problem.get(), step++, &whole, &u_full, &R.contact.gap, &rows});
     };
   }
   // this rank's contact nodes (all of them on one rank): the law and a given initial iterate

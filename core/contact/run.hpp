@@ -26,13 +26,15 @@ struct NestedLevel {
 };
 
 // One Newton iterate of the fine mesh with the body's displacement, for
-// output (RunOptions::iterate_done); pointers valid during the call.
+// output (RunOptions::iterate_done); pointers valid during the call. The
+// progress's contact vectors hold every contact node, on every rank.
 struct Iterate {
   const Problem* problem;
   int step;  // 0, 1, ... over the run (a Coulomb fixed point's Tresca solves continue it)
   const NewtonProgress* progress;
-  const std::vector<real>* u_full;  // 3N SoA: E u + K_ii^{-1} l_i
+  const std::vector<real>* u_full;  // 3N SoA: E u + K_ii^{-1} l_i (several ranks: on `slab`, ghost rows current)
   const std::vector<real>* gap;     // p
+  const Slab* slab;                 // the rank's rows of u_full (one rank: the whole grid)
 };
 
 struct RunOptions {
