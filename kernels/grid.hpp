@@ -28,6 +28,17 @@ struct GridDims {
   real hz() const { return lz / real(ez); }
 };
 
+// The node rows [a, b) of g (all of x and z) as a grid of their own: the same
+// spacing up to rounding of ly / ey (operators on a part of a larger grid
+// take that grid's spacing: build_elasticity_stencil's h).
+inline GridDims rows_box(const GridDims& g, index a, index b) {
+  GridDims r = g;
+  r.ey = b - a - 1;
+  r.y0 = g.y0 + real(a) * g.hy();
+  r.ly = g.hy() * real(r.ey);
+  return r;
+}
+
 // Is node (ix,iy,iz) on a constrained face?
 inline bool node_constrained(const GridDims& g, unsigned faces, index ix, index iy, index iz) {
   return ((faces & kFaceX0) && ix == 0) || ((faces & kFaceX1) && ix == g.ex) ||

@@ -52,15 +52,8 @@ Transfer build_transfer(const GridDims& fine, const GridDims& coarse) {
 Transfer slice_rows(const Transfer& t, index f0, index f1, index c0, index c1) {
   TRESCA_ASSERT(0 <= f0 && f0 + 2 <= f1 && f1 <= t.fine.ny() && 0 <= c0 && c0 + 2 <= c1 && c1 <= t.coarse.ny());
   Transfer s = t;
-  auto box = [](const GridDims& g, index a, index b) {
-    GridDims r = g;
-    r.ey = b - a - 1;
-    r.y0 = g.y0 + real(a) * g.hy();
-    r.ly = g.hy() * real(r.ey);
-    return r;
-  };
-  s.fine = box(t.fine, f0, f1);
-  s.coarse = box(t.coarse, c0, c1);
+  s.fine = rows_box(t.fine, f0, f1);
+  s.coarse = rows_box(t.coarse, c0, c1);
   const Interp1D& Y = t.axis[1];
   Interp1D y;
   for (index i = f0; i < f1; ++i) {

@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #ifdef TRESCA_HAVE_MPI
 #include <mpi.h>
@@ -22,14 +23,6 @@ const Comm& Comm::world() { return world_instance(); }
 CommCounters& comm_counters() {
   static CommCounters c;
   return c;
-}
-
-bool mpi_enabled() {
-#ifdef TRESCA_HAVE_MPI
-  return true;
-#else
-  return false;
-#endif
 }
 
 namespace {
@@ -63,14 +56,7 @@ MpiSession::~MpiSession() {
 }
 
 real Comm::sum(real local) const {
-#ifdef TRESCA_HAVE_MPI
-  if (size_ > 1) {
-    real global = 0;
-    MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-    comm_counters().allreduces += 1;
-    return global;
-  }
-#endif
+  sum(&local, 1);
   return local;
 }
 
@@ -112,12 +98,13 @@ void Comm::allgather(real* v, const std::vector<int>& counts, const std::vector<
 #endif
 }
 
-void Comm::broadcast(real* v, int n, int root) const {
+template <class T>
+void Comm::broadcast(T* v, int n, int root) const {
 #ifdef TRESCA_HAVE_MPI
   if (size_ > 1) {
-    MPI_Bcast(v, n, MPI_DOUBLE, root, MPI_COMM_WORLD);
+    MPI_Bcast(v, n, std::is_same<T, float>::value ? MPI_FLOAT : MPI_DOUBLE, root, MPI_COMM_WORLD);
     comm_counters().collectives += 1;
-    if (rank_ == root) comm_counters().bytes += double(n) * sizeof(real) * (size_ - 1);
+    if (rank_ == root) comm_counters().bytes += double(n) * sizeof(T) * (size_ - 1);
   }
 #else
   (void)v;
@@ -125,20 +112,8 @@ void Comm::broadcast(real* v, int n, int root) const {
   (void)root;
 #endif
 }
-
-void Comm::broadcast(float* v, int n, int root) const {
-#ifdef TRESCA_HAVE_MPI
-  if (size_ > 1) {
-    MPI_Bcast(v, n, MPI_FLOAT, root, MPI_COMM_WORLD);
-    comm_counters().collectives += 1;
-    if (rank_ == root) comm_counters().bytes += double(n) * sizeof(float) * (size_ - 1);
-  }
-#else
-  (void)v;
-  (void)n;
-  (void)root;
-#endif
-}
+template void Comm::broadcast<real>(real*, int, int) const;
+template void Comm::broadcast<float>(float*, int, int) const;
 
 int Comm::ranks_on_this_host() const {
 #ifdef TRESCA_HAVE_MPI

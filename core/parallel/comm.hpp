@@ -28,8 +28,9 @@ class Comm {
   void allgather(real* v, const std::vector<int>& counts, const std::vector<int>& displs) const;
   void barrier() const;
   // v[0..n) of rank `root` to every rank
-  void broadcast(real* v, int n, int root = 0) const;
-  void broadcast(float* v, int n, int root = 0) const;
+  // (T = double or float)
+  template <class T>
+  void broadcast(T* v, int n, int root = 0) const;
   // how many ranks run on this rank's machine (MPI_COMM_TYPE_SHARED)
   int ranks_on_this_host() const;
 
@@ -58,9 +59,6 @@ class MpiSession {
   MpiSession(const MpiSession&) = delete;
   MpiSession& operator=(const MpiSession&) = delete;
 };
-
-// whether this build talks MPI (TRESCA_HAVE_MPI)
-bool mpi_enabled();
 
 // How many ranks the process launcher started, from its environment
 // (Open MPI, MPICH), whether or not this build has MPI: lets a

@@ -13,19 +13,6 @@
 namespace tresca {
 
 namespace {
-// the ghost or boundary row j of all planes and components <-> a packed buffer
-template <class T>
-void pack_row(const GridDims& g, const T* v, index j, T* buf) {
-  const index nx = g.nx(), N = g.nodes();
-  for (int c = 0; c < 3; ++c)
-    for (index iz = 0; iz < g.nz(); ++iz) std::copy_n(v + c * N + g.node(0, j, iz), nx, buf + (c * g.nz() + iz) * nx);
-}
-template <class T>
-void unpack_row(const GridDims& g, const T* buf, index j, T* v) {
-  const index nx = g.nx(), N = g.nodes();
-  for (int c = 0; c < 3; ++c)
-    for (index iz = 0; iz < g.nz(); ++iz) std::copy_n(buf + (c * g.nz() + iz) * nx, nx, v + c * N + g.node(0, j, iz));
-}
 template <class T>
 void fill_row(const GridDims& g, T value, index j, T* v) {
   const index nx = g.nx(), N = g.nodes();
@@ -76,11 +63,11 @@ void DistributedElasticity::begin_exchange(const T* x) const {
   if (slab_.lo) MPI_Irecv(buf[2].data(), n, type, slab_.rank - 1, 0, MPI_COMM_WORLD, &req[pending_++]);
   if (slab_.hi) MPI_Irecv(buf[3].data(), n, type, slab_.rank + 1, 1, MPI_COMM_WORLD, &req[pending_++]);
   if (slab_.lo) {
-    pack_row(g, x, slab_.lo, buf[0].data());
+    rows_to_buffer(g, x, slab_.lo, slab_.lo + 1, buf[0].data());
     MPI_Isend(buf[0].data(), n, type, slab_.rank - 1, 1, MPI_COMM_WORLD, &req[pending_++]);
   }
   if (slab_.hi) {
-    pack_row(g, x, slab_.lo + slab_.owned_rows() - 1, buf[1].data());
+    rows_to_buffer(g, x, slab_.lo + slab_.owned_rows() - 1, slab_.lo + slab_.owned_rows(), buf[1].data());
     MPI_Isend(buf[1].data(), n, type, slab_.rank + 1, 0, MPI_COMM_WORLD, &req[pending_++]);
   }
   counts_.exchanges += 1;
@@ -112,8 +99,8 @@ void DistributedElasticity::end_exchange(T* x) const {
   pending_ = 0;
   const GridDims& g = slab_.local;
   const std::vector<T>* buf = buffers<T>();
-  if (slab_.lo) unpack_row(g, buf[2].data(), 0, x);
-  if (slab_.hi) unpack_row(g, buf[3].data(), slab_.lo + slab_.owned_rows(), x);
+  if (slab_.lo) buffer_to_rows(g, buf[2].data(), 0, 1, x);
+  if (slab_.hi) buffer_to_rows(g, buf[3].data(), slab_.lo + slab_.owned_rows(), slab_.lo + slab_.owned_rows() + 1, x);
 #else
   (void)x;
 #endif

@@ -13,36 +13,12 @@
 
 namespace tresca {
 
-GridDims row_box(const GridDims& g, index a, index b) {
-  GridDims box = g;
-  box.ey = b - a - 1;
-  box.y0 = g.y0 + real(a) * g.hy();
-  box.ly = g.hy() * real(box.ey);
-  return box;
-}
-
-namespace {
-// rows [r0, r1) of all planes and components of a vector on grid g <-> packed
-template <class T>
-void rows_to_buffer(const GridDims& g, const T* v, index r0, index r1, T* buf) {
-  const index nx = g.nx(), N = g.nodes(), len = (r1 - r0) * nx;
-  for (int c = 0; c < 3; ++c)
-    for (index iz = 0; iz < g.nz(); ++iz, buf += len) std::copy_n(v + c * N + g.node(0, r0, iz), len, buf);
-}
-template <class T>
-void buffer_to_rows(const GridDims& g, const T* buf, index r0, index r1, T* v) {
-  const index nx = g.nx(), N = g.nodes(), len = (r1 - r0) * nx;
-  for (int c = 0; c < 3; ++c)
-    for (index iz = 0; iz < g.nz(); ++iz, buf += len) std::copy_n(buf, len, v + c * N + g.node(0, r0, iz));
-}
-}  // namespace
-
 RowFetch::RowFetch(const Slab& s, index a, index b, const Comm& comm) : s_(s), comm_(comm), a_(a), b_(b) {
   const bool none = a == 0 && b == 0;  // this rank takes part but wants nothing
   if (!none && (!(0 <= a && a < b && b <= s.global.ny()) || b - a < 2))
     throw std::invalid_argument("RowFetch: rows [" + std::to_string(a) + ", " + std::to_string(b) + ") of " +
                                 std::to_string(s.global.ny()));
-  box_ = none ? GridDims{} : row_box(s.global, a, b);
+  box_ = none ? GridDims{} : rows_box(s.global, a, b);
   const int P = comm.size();
   std::vector<long long> mine = {(long long)a, (long long)b, (long long)s.y_begin, (long long)s.y_end};
   std::vector<long long> all(4 * size_t(P));

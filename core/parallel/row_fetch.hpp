@@ -47,9 +47,6 @@ class RowFetch {
   double bytes_ = 0;
 };
 
-// the rows [a, b) of g as a box of their own (spacing up to rounding, slab.hpp)
-GridDims row_box(const GridDims& g, index a, index b);
-
 // uf = P uc between two meshes of one box (trilinear, build_transfer), each
 // a 3-component vector on its slab (a slab of one rank: the whole grid,
 // held by every rank): the coarse rows the fine slab's rows interpolate

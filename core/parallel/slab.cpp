@@ -33,11 +33,7 @@ Slab make_slab(const GridDims& g, int rank, int ranks) {
   s.hi = rank + 1 < ranks ? 1 : 0;
   s.local = g;
   if (ranks == 1) return s;
-  const index first = s.y_begin - s.lo, rows = s.owned_rows() + s.lo + s.hi;
-  const real hy = g.hy();
-  s.local.ey = rows - 1;
-  s.local.y0 = g.y0 + real(first) * hy;
-  s.local.ly = hy * real(s.local.ey);  // hy up to rounding: the kernels take the global spacing
+  s.local = rows_box(g, s.y_begin - s.lo, s.y_end + s.hi);
   return s;
 }
 

@@ -13,6 +13,8 @@
 //
 //   local row j = global row iy - (y_begin - lo);  owned: lo <= j < lo + owned_rows()
 #pragma once
+#include <algorithm>
+
 #include "kernels/grid.hpp"
 
 namespace tresca {
@@ -33,6 +35,22 @@ struct Slab {
 // rank's slab of g among `ranks`; throws std::invalid_argument if there are
 // fewer node rows than ranks
 Slab make_slab(const GridDims& g, int rank, int ranks);
+
+// Rows [r0, r1) of all planes and components of a SoA vector on grid g to
+// a packed buffer (component, plane, then the rows' nodes), and back: the
+// messages of ghost exchanges and row fetches. T = double or float.
+template <class T>
+void rows_to_buffer(const GridDims& g, const T* v, index r0, index r1, T* buf) {
+  const index N = g.nodes(), len = (r1 - r0) * g.nx();
+  for (int c = 0; c < 3; ++c)
+    for (index iz = 0; iz < g.nz(); ++iz, buf += len) std::copy_n(v + c * N + g.node(0, r0, iz), len, buf);
+}
+template <class T>
+void buffer_to_rows(const GridDims& g, const T* buf, index r0, index r1, T* v) {
+  const index N = g.nodes(), len = (r1 - r0) * g.nx();
+  for (int c = 0; c < 3; ++c)
+    for (index iz = 0; iz < g.nz(); ++iz, buf += len) std::copy_n(buf, len, v + c * N + g.node(0, r0, iz));
+}
 
 // SoA (3 components) global vector -> rank's local vector (owned and ghost rows)
 void global_to_local(const Slab& s, const real* global, real* local);
