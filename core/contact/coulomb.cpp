@@ -106,11 +106,11 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, const std::vector<re
       C.reason = CoulombReason::iteration_limit;
       return C;
     }
-    // continue from this solution and its tracked S u
+    // continue from this solution and its tracked S u and E u
     no.u0 = &L.u;
     no.lambda0 = &L.lambda;
     no.Su0 = &L.Su;
-    no.extension0 = nullptr;
+    no.extension0 = &L.extension;
   }
 }
 

@@ -173,8 +173,10 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   }
   const double t3 = wall_time();
   if (opt.phase_done) opt.phase_done("semismooth* Newton", t3 - t2);
-  // the final check's tight S u, warm from E u0 when there is one, also
-  // gives E u: u = E u + K_ii^{-1} l_i
+  // the final check's tight S u, warm from Newton's tracked E u (or, if
+  // Newton did not run, E u0), also gives E u: u = E u + K_ii^{-1} l_i
+  if (!R.newton.extension.empty()) extension = std::move(R.newton.extension);
+  R.newton.extension = {};
   const bool warm = !extension.empty();
   R.report = final_report(S, btilde, law, R.newton, opt.tight_rtol, &extension, warm);
   if (S.distributed()) {

@@ -122,19 +122,22 @@ void add_coupling(const ReducedSystem& L, index p, const real* Sx, real* y) {
   }
 }
 
-// y = mask_F (S x + H x (+ F t (S x)_z: Coulomb Newton)), with S x as the side product: the CG's running
-// S Δu, whose norm sets the accuracy of the bookkeeping apply of S Δu (step
-// 4). The inner tolerance is this step's own state, relaxed as its outer CG
-// converges.
+// y = mask_F (S x + H x (+ F t (S x)_z: Coulomb Newton)), with the side
+// product [S x | E x] (3p + S.full_size()): the CG accumulates both along its
+// iterate, so after the step it holds the running S Δu_F, whose norm sets the
+// accuracy of the bookkeeping apply of S Δu, and E Δu_F, that apply's initial
+// guess. The inner tolerance is this step's own state, relaxed as its outer
+// CG converges.
 class ReducedNewtonOperator : public LinearOperatorWithSide {
  public:
   ReducedNewtonOperator(const SteklovPoincare& S, const ReducedSystem& L, InnerWork& work)
       : S_(S), L_(L), work_(work) {}
   index size() const override { return S_.size(); }
-  index side_size() const override { return S_.size(); }
+  index side_size() const override { return S_.size() + S_.full_size(); }
   void set_inner_rtol(real r) { rtol_ = r; }
-  void apply(const real* x, real* y, real* Sx) const override {
-    work_.apply(S_, x, Sx, rtol_);
+  void apply(const real* x, real* y, real* side) const override {
+    real* Sx = side;
+    work_.apply(S_, x, Sx, rtol_, side + S_.size());
     const index p = S_.size() / 3;
     const real* h = L_.h.data();
     for (index i = 0; i < p; ++i) {
@@ -147,8 +150,8 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
       if (!L_.free[i]) y[i] = 0;
   }
   void apply(const real* x, real* y) const override {
-    std::vector<real> Sx(S_.size());  // the Newton step always asks for S x too
-    apply(x, y, Sx.data());
+    std::vector<real> side(side_size());  // the Newton step always asks for S x too
+    apply(x, y, side.data());
   }
 
  private:
@@ -166,18 +169,20 @@ struct StepOutcome {
 
 // Solves the reduced system of L for Δu_F (into du) to the relative
 // accuracy eta (forcing term; semismooth.hpp: Tolerances), floored at the
-// absolute `floor`; Sdu gets the CG's running estimate of S Δu (inexact).
+// absolute `floor`; side gets the CG's running estimates [S Δu | E Δu] of the
+// whole step (known increments included; inexact; GMRES: the known part only).
 StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreconditioner* M, real eta, real floor,
                        bool any_known, InnerWork& work, CGWorkspace& ws, std::vector<real>& du,
-                       std::vector<real>& Sdu, std::vector<real>& scratch) {
-  const index n3 = S.size();
+                       std::vector<real>& side, std::vector<real>& known_side) {
+  const index n3 = S.size(), nf = S.full_size();
+  real* scratch = known_side.data();  // S Δu_known, then E Δu_known
   StepOutcome out;
   const long long fails0 = work.failures;
   // known increments enter the right-hand side: r_F -= (S Δu_known)_F; an
   // error there is an error of the step, so the inner accuracy follows eta
   const real inner_max = 1e-2;
   if (any_known) {
-    if (!work.apply(S, L.known.data(), scratch.data(), std::clamp(0.1 * eta, real(1e-12), inner_max))) {
+    if (!work.apply(S, L.known.data(), scratch, std::clamp(0.1 * eta, real(1e-12), inner_max), scratch + n3)) {
       out.inner_failed = true;
       return out;
     }
@@ -185,12 +190,12 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
       if (L.free[i]) L.rhs[i] -= scratch[i];
     if (L.coupled) {  // ... and its F t (S Δu_known)_z on the coupled rows
       std::vector<real> c(n3, 0.0);
-      add_coupling(L, n3 / 3, scratch.data(), c.data());
+      add_coupling(L, n3 / 3, scratch, c.data());
       for (index i = 0; i < n3; ++i)
         if (L.free[i]) L.rhs[i] -= c[i];
     }
   } else {
-    std::fill(scratch.begin(), scratch.end(), 0.0);
+    std::fill(known_side.begin(), known_side.end(), 0.0);
   }
   if (M) M->update(L.h, L.fixed, L.free);
   ReducedNewtonOperator A(S, L, work);
@@ -220,14 +225,14 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
     go.comm = co.comm;
     ScopedTimer t(Kernel::outer_cg);
     out.outer = gmres(A, M, L.rhs.data(), du.data(), go);
-    std::fill(Sdu.begin(), Sdu.end(), 0.0);
+    std::fill(side.begin(), side.end(), 0.0);
   } else {
     ScopedTimer t(Kernel::outer_cg);
-    out.outer = pcg(A, M, L.rhs.data(), du.data(), Sdu.data(), co, ws);
+    out.outer = pcg(A, M, L.rhs.data(), du.data(), side.data(), co, ws);
   }
   if (M) work.fine_matvecs += out.outer.preconditioner_applications * M->apply_work();
   out.inner_failed = work.failures > fails0;
-  axpy(n3, 1, scratch.data(), Sdu.data());
+  axpy(n3 + nf, 1, scratch, side.data());
   return out;
 }
 
@@ -292,24 +297,29 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     return R;
   };
   if (opt.Su0 && index(opt.Su0->size()) != n3) size_error("Su0", opt.Su0->size(), n3);
+  // E u, tracked with S u: the warm start of every bookkeeping apply's
+  // solve and, on return, of the final check's
+  R.extension.assign(S.full_size(), 0);
+  if (opt.extension0 && index(opt.extension0->size()) != S.full_size())
+    size_error("extension0", opt.extension0->size(), S.full_size());
   if (opt.u0 && opt.lambda0) {
     R.u = *opt.u0;
     R.lambda = *opt.lambda0;
+    if (opt.extension0) R.extension = *opt.extension0;
     if (opt.Su0) {
       R.Su = *opt.Su0;
     } else {
       // S u0 starts the bookkeeping of S u: the same accuracy as every S Δu
       R.operator_applications += 1;
-      real* ext = nullptr;
-      if (opt.extension0) {
-        opt.extension0->resize(S.full_size());
-        ext = opt.extension0->data();
-      }
-      if (!work.apply(S, R.u.data(), R.Su.data(), std::max(opt.book_accuracy, real(1e-12)), ext, ext))
+      real* ext = R.extension.data();
+      if (!work.apply(S, R.u.data(), R.Su.data(), std::max(opt.book_accuracy, real(1e-12)), ext,
+                      opt.extension0 ? ext : nullptr))
         return finish(NewtonReason::inner_failure);
     }
   }
-  std::vector<real> r(n3), v(4 * p), d(3 * p), du(n3), Sdu(n3), scratch(n3);
+  const index nf = S.full_size();
+  // side: [S Δu | E Δu] of the step; known_side: the same of its known increments
+  std::vector<real> r(n3), v(4 * p), d(3 * p), du(n3), side(n3 + nf), known_side(n3 + nf);
   std::vector<real> v_at_d(opt.coulomb_newton ? 4 * p : 0);  // (Coulomb Newton: the second step's v̂, not used)
   ReducedSystem L(n3);
   std::unique_ptr<BoundaryPreconditioner> M;
@@ -388,7 +398,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     eta = std::min(opt.forcing_max, std::max(eta, real(0.1) * tol / vnorm));
 
     // 3. the reduced Newton system, by preconditioned CG on the boundary
-    const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * tol, any_known, work, ws, du, Sdu, scratch);
+    const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * tol, any_known, work, ws, du, side, known_side);
     R.outer_iterations += step.outer.iterations;
     R.operator_applications += step.outer.iterations + (any_known ? 1 : 0);
     if (step.inner_failed) return finish(NewtonReason::inner_failure);
@@ -399,22 +409,26 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     if (limit && last_step_hit_limit) return finish(NewtonReason::outer_failure);
     last_step_hit_limit = limit;
 
-    // 4. update x = (u, lambda) and S u. The step may be inexact, but S Δu
-    // must be accurate: S u is kept incrementally and its error stays in every
-    // later residual. One application of S to the whole Δu, to an absolute
-    // accuracy of book_accuracy |b̃| (relative to the CG's estimate of S Δu).
+    // 4. update x = (u, lambda), S u and E u. The step may be inexact, but
+    // S Δu must be accurate: S u is kept incrementally and its error stays
+    // in every later residual. One application of S to the whole Δu, to an
+    // absolute accuracy of book_accuracy |b̃| (relative to the CG's estimate
+    // of S Δu), its inner solve warm from the CG's running E Δu.
     for (index i = 0; i < n3; ++i) du[i] += L.known[i];
+    real* Sdu = side.data();
+    real* Edu = side.data() + n3;
     // |S Δu| from the CG's side product, or (GMRES) bounded by max s |Δu|
     const real sdu_norm = L.coupled ? smax * std::sqrt(S.sum(dot(n3, du.data(), du.data())))
-                                    : std::sqrt(S.sum(dot(n3, Sdu.data(), Sdu.data())));
+                                    : std::sqrt(S.sum(dot(n3, Sdu, Sdu)));
     const real book_rtol =
         sdu_norm > 0 ? std::clamp(opt.book_accuracy * bnorm / sdu_norm, real(1e-12), real(1e-1)) : real(1e-1);
     R.operator_applications += 1;
-    if (!work.apply(S, du.data(), Sdu.data(), book_rtol)) return finish(NewtonReason::inner_failure);
+    if (!work.apply(S, du.data(), Sdu, book_rtol, Edu, Edu)) return finish(NewtonReason::inner_failure);
     for (index i = 0; i < p; ++i)
       R.lambda[i] += L.dlambda[i] + ((R.status[i] & kContact) ? Sdu[2 * p + i] : 0);
     axpy(n3, 1, du.data(), R.u.data());
-    axpy(n3, 1, Sdu.data(), R.Su.data());
+    axpy(n3, 1, Sdu, R.Su.data());
+    axpy(nf, 1, Edu, R.extension.data());
     R.iterations = k + 1;
   }
 }

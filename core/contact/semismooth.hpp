@@ -92,9 +92,9 @@ struct NewtonOptions {
   // S u0 is then formed with a tight inner solve
   const std::vector<real>* u0 = nullptr;
   const std::vector<real>* lambda0 = nullptr;
-  // optional, with u0: on entry an initial guess of E u0 (3N, steklov.hpp)
-  // for that solve, on return E u0
-  std::vector<real>* extension0 = nullptr;
+  // optional, with u0: E u0 (S.full_size(), steklov.hpp): with Su0 E u0
+  // itself, else the initial guess of the S u0 solve
+  const std::vector<real>* extension0 = nullptr;
   // optional, with u0: S u0 itself (3p), e.g. the tracked S u of an earlier
   // solve from which this one continues; then no solve is needed for it
   const std::vector<real>* Su0 = nullptr;
@@ -117,6 +117,7 @@ struct NewtonResult {
   std::vector<real> history;           // ||v̂|| after each approximation step (first at x0)
   std::vector<long long> inner_history, outer_history;  // cumulative inner / outer CG iterations there
   std::vector<real> u, lambda, Su;     // 3p, p, 3p
+  std::vector<real> extension;         // E u (S.full_size()), tracked with S u to the same accuracy
   std::vector<std::uint8_t> status;    // per node: kContact | kStick at the last approximation step
   std::vector<real> phi;               // the Tresca bound of the last approximation step
   std::vector<real> scale;             // the steps' metric s_i (step_scale), empty: the paper's (s = 1)
