@@ -151,7 +151,6 @@ void expect_dense_steps(const SteklovPoincare& S, const DenseSchur& D, const Den
   for (real h : run.history) std::printf(" %.3e", h);
   std::printf("\n");
   const index p = S.size() / 3;
-  const std::vector<real> bt(D.b.data(), D.b.data() + 3 * p);
   for (int k = 0; k + 1 < int(ref.iterates.size()); ++k) {
     std::vector<real> u0(3 * p), l0(p);
     for (index i = 0; i < p; ++i) {
@@ -163,7 +162,8 @@ void expect_dense_steps(const SteklovPoincare& S, const DenseSchur& D, const Den
     no.max_iterations = 1;
     no.u0 = &u0;
     no.lambda0 = &l0;
-    const NewtonResult step = semismooth_newton(S, bt, law, no);
+    no.force_scale = D.b.norm();
+    const NewtonResult step = semismooth_newton(S, law, no);
     EXPECT_NEAR(step.history[0], ref.history[k], 1e-8 * ref.history[k] + 1e-12 * ref.history[0]) << "k=" << k;
     real umax, lmax;
     const auto e = iterate_errors(step.u, step.lambda, ref.iterates[k + 1], umax, lmax);

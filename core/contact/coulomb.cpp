@@ -19,7 +19,7 @@ const char* to_string(CoulombReason r) {
   return "?";
 }
 
-CoulombResult coulomb_fixed_point(const SteklovPoincare& S, const std::vector<real>& btilde, ContactConditions law,
+CoulombResult coulomb_fixed_point(const SteklovPoincare& S, ContactConditions law,
                                   const CoulombOptions& co, const NewtonOptions& newton) {
   if (!(co.F >= 0) || !std::isfinite(co.F))
     throw std::invalid_argument("coulomb: the friction coefficient " + std::to_string(co.F) + " must be >= 0 and finite");
@@ -35,7 +35,7 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, const std::vector<re
   for (int m = 0;; ++m) {
     const bool to_eps = m == 0 || change <= co.tol;
     no.rtol = to_eps ? newton.rtol : std::max(newton.rtol, real(0.1) * change);
-    NewtonResult R = semismooth_newton(S, btilde, law, no);
+    NewtonResult R = semismooth_newton(S, law, no);
     C.iterations = m + 1;
     C.newton_steps += R.iterations;
     C.inner_iterations += R.inner_iterations;
@@ -106,11 +106,12 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, const std::vector<re
       C.reason = CoulombReason::iteration_limit;
       return C;
     }
-    // continue from this solution and its tracked S u and E u
+    // continue from this solution, its residual and body
     no.u0 = &L.u;
     no.lambda0 = &L.lambda;
-    no.Su0 = &L.Su;
-    no.extension0 = &L.extension;
+    no.r0 = &L.r;
+    no.body0 = &L.body;
+    no.force_scale = L.force_scale;
   }
 }
 

@@ -40,7 +40,7 @@ struct CoulombResult {
 };
 
 // law.gap is used as given, law.phi is overwritten (phi^0 above)
-CoulombResult coulomb_fixed_point(const SteklovPoincare& S, const std::vector<real>& btilde, ContactConditions law,
+CoulombResult coulomb_fixed_point(const SteklovPoincare& S, ContactConditions law,
                                   const CoulombOptions& co, const NewtonOptions& newton);
 
 }  // namespace tresca

@@ -8,17 +8,17 @@
 
 namespace tresca {
 
-FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
-                         const NewtonResult& R, real tight_rtol, std::vector<real>* extension, bool warm) {
+FinalReport final_report(const SteklovPoincare& S, const ContactConditions& law, const NewtonResult& R,
+                         real tight_rtol, std::vector<real>* body) {
   const index p = S.size() / 3;
   const std::vector<real>& phi = law.phi;
   FinalReport F;
-  std::vector<real> Su(3 * p), v(4 * p), d(3 * p);
-  if (extension) extension->resize(S.full_size());
-  real* ext = extension ? extension->data() : nullptr;
-  F.inner = S.apply(R.u.data(), Su.data(), tight_rtol, ext, warm ? ext : nullptr);
+  std::vector<real> v(4 * p), d(3 * p);
+  const bool warm = body && !body->empty();
+  if (body) body->resize(S.full_size());
+  real* U = body ? body->data() : nullptr;
   F.r.resize(3 * p);
-  for (index i = 0; i < 3 * p; ++i) F.r[i] = Su[i] - btilde[i];
+  F.inner = S.residual(R.u.data(), F.r.data(), tight_rtol, U, warm ? U : nullptr);
   F.status.resize(p);
   // the residual is the paper's |v̂| either way; the status (which nodes are
   // in contact, which stick) is decided in Newton's metric R.scale, so that
@@ -26,7 +26,7 @@ FinalReport final_report(const SteklovPoincare& S, const std::vector<real>& btil
   F.true_residual = std::sqrt(S.sum(approximation_step(p, law.law(), R.scale.empty() ? nullptr : R.scale.data(),
                                                        R.u.data(), R.lambda.data(), F.r.data(), v.data(), d.data(),
                                                        F.status.data())));
-  F.btilde_norm = std::sqrt(S.sum(dot(3 * p, btilde.data(), btilde.data())));
+  F.btilde_norm = R.force_scale;
   F.true_residual_relative = F.btilde_norm > 0 ? F.true_residual / F.btilde_norm : F.true_residual;
   F.ux_min = INFINITY;
   F.uz_max = -INFINITY;

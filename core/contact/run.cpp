@@ -48,14 +48,15 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.contact = opt.contact.phi.empty() ? contact_conditions(spec) : opt.contact;
   // nested iteration: the coarser mesh first (before this mesh's operators
   // exist, so the peak memory stays this mesh's). It hands up (u, lambda)
-  // as the Newton initial iterate and, trilinearly interpolated, its K_ii^{-1}
-  // l_i and E u as initial guesses of this mesh's tight inner solves.
+  // as the Newton initial iterate and, trilinearly interpolated, its body
+  // and K_ii^{-1} l_i as initial guesses of this mesh's first residual and |b̃|.
   NewtonOptions newton = opt.newton;
-  std::vector<real> u0, lambda0, load_guess, extension;  // extension: E u0, then E u
+  std::vector<real> u0, lambda0, load_guess, body;  // body: the guess at u0, then U = E u + K_ii^{-1} l_i
   if (opt.nested && !newton.u0 && has_coarser(spec, opt.nested_min_contact_nodes)) {
     const ProblemSpec cs = coarser_spec(spec);
     RunOptions co = opt;
     co.recover_interior = true;
+    co.keep_interior_load = true;
     co.newton.progress = nullptr;
     co.iterate_done = nullptr;
     co.phase_done = nullptr;  // one line per coarse mesh: nested_done
@@ -63,7 +64,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     co.coulomb_tol = std::max(opt.coulomb_tol, opt.nested_rtol);
     // and need their forces only to a fraction of that accuracy
     co.tight_rtol = std::max(opt.tight_rtol, 1e-3 * opt.nested_rtol);
-    co.newton.book_accuracy = std::max(opt.newton.book_accuracy, 1e-3 * opt.nested_rtol);
+    co.newton.residual_accuracy = std::max(opt.newton.residual_accuracy, 1e-3 * opt.nested_rtol);
     co.contact = coarse_conditions(R.problem->grid, R.contact, grid_of(cs));
     const RunResult C = run_tresca(cs, co);
     R.nested = C.nested;
@@ -75,19 +76,16 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
       prolongate_contact(C.problem->grid, C.newton.u, C.newton.lambda, R.problem->grid, u0, lambda0);
       newton.u0 = &u0;
       newton.lambda0 = &lambda0;
-    }
-    if (C.converged()) {
       // on the slab this mesh's operators will use (the whole grid on one rank)
       const Comm& comm = Comm::world();
       const GridDims& g = R.problem->grid;
       const Slab fine = worth_distributing(g, comm) ? make_slab(g, comm.rank(), comm.size()) : make_slab(g, 0, 1);
       const index n = 3 * fine.local.nodes();
       load_guess.resize(n);
-      extension.resize(n);
+      body.resize(n);
       prolongate_slabs(C.slab, C.interior_load.data(), fine, load_guess.data(), comm);
-      prolongate_slabs(C.slab, C.u_full.data(), fine, extension.data(), comm);  // E u_c + K_ii^{-1} l_i
-      axpy(n, -1, load_guess.data(), extension.data());
-      newton.extension0 = &extension;
+      prolongate_slabs(C.slab, C.u_full.data(), fine, body.data(), comm);
+      newton.body0 = &body;
     }
   }
   const double t0s = wall_time();
@@ -99,18 +97,17 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     const Slab rows = S.distributed() ? S.slab() : make_slab(R.problem->grid, 0, 1);
     newton.progress = [&, rows, shown = newton.progress, step = 0](const NewtonProgress& pr) mutable {
       if (shown) shown(pr);
-      std::vector<real> Su(pr.u->size()), u_full(S.full_size());
-      S.apply(pr.u->data(), Su.data(), 1e-8, u_full.data());
-      axpy(index(u_full.size()), 1, R.interior_load.data(), u_full.data());
+      std::vector<real> r(pr.u->size()), u_full(S.full_size());
+      S.residual(pr.u->data(), r.data(), 1e-8, u_full.data());
       S.exchange_ghosts(u_full.data());
       // every contact node's values (several ranks: gathered)
-      const std::vector<real> u = S.whole(*pr.u, 3), lambda = S.whole(*pr.lambda, 1), r = S.whole(*pr.r, 3),
+      const std::vector<real> u = S.whole(*pr.u, 3), lambda = S.whole(*pr.lambda, 1), rw = S.whole(*pr.r, 3),
                               phi = S.whole(*pr.phi, 1);
       const std::vector<std::uint8_t> status = S.whole(*pr.status);
       NewtonProgress whole = pr;
       whole.u = &u;
       whole.lambda = &lambda;
-      whole.r = &r;
+      whole.r = &rw;
       whole.phi = &phi;
       whole.status = &status;
       opt.iterate_done(Iterate{R.problem.get(), step++, &whole, &u_full, &R.contact.gap, &rows});
@@ -129,12 +126,20 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
       newton.lambda0 = &lambda0_local;
     }
   }
-  std::vector<real> btilde;
-  const SolveStats cond = S.condensed_load(opt.tight_rtol, btilde, &R.interior_load,
-                                           load_guess.empty() ? nullptr : load_guess.data());
+  // |b̃|, the scale of Newton's absolute accuracies and of the report: from
+  // x0 = 0 Newton's first residual is -b̃; an initial iterate takes a loose
+  // solve of its own (a coarser mesh of nested iteration always, to hand up
+  // its K_ii^{-1} l_i)
+  SolveStats cond;
+  if (newton.u0 || opt.keep_interior_load) {
+    std::vector<real> btilde;
+    cond = S.condensed_load(opt.scale_rtol, btilde, opt.keep_interior_load ? &R.interior_load : nullptr,
+                            load_guess.empty() ? nullptr : load_guess.data());
+    newton.force_scale = std::sqrt(S.sum(dot(index(btilde.size()), btilde.data(), btilde.data())));
+  }
   load_guess = {};
   const double t2 = wall_time();
-  if (opt.phase_done) opt.phase_done("condensed load", t2 - t1);
+  if (opt.phase_done && newton.force_scale > 0) opt.phase_done("|b~| (loose condensed load)", t2 - t1);
   if (!cond.ok()) {
     // b̃ is untrustworthy: report instead of iterating on a wrong problem
     const index p = S.contact_nodes();
@@ -146,7 +151,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.coulomb = true;
     newton.coulomb = opt.coulomb;
     newton.coulomb_newton = opt.coulomb_method == RunOptions::CoulombMethod::newton;
-    R.newton = semismooth_newton(S, btilde, law, newton);
+    R.newton = semismooth_newton(S, law, newton);
     law.phi = R.newton.phi;
     R.coulomb_loop.iterations = 1;
     R.coulomb_loop.reason = R.newton.converged() ? CoulombReason::converged : CoulombReason::tresca_failed;
@@ -158,12 +163,12 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     CoulombOptions co;
     co.F = opt.coulomb;
     co.tol = opt.coulomb_tol;
-    R.coulomb_loop = coulomb_fixed_point(S, btilde, law, co, newton);
+    R.coulomb_loop = coulomb_fixed_point(S, law, co, newton);
     R.newton = std::move(R.coulomb_loop.last);
     R.coulomb_loop.last = {};
     law = R.coulomb_loop.law;
   } else {
-    R.newton = semismooth_newton(S, btilde, law, newton);
+    R.newton = semismooth_newton(S, law, newton);
   }
   if (R.coulomb) {
     for (index i = 0; i < S.contact_nodes(); ++i)
@@ -173,19 +178,18 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   }
   const double t3 = wall_time();
   if (opt.phase_done) opt.phase_done("semismooth* Newton", t3 - t2);
-  // the final check's tight S u, warm from Newton's tracked E u (or, if
-  // Newton did not run, E u0), also gives E u: u = E u + K_ii^{-1} l_i
-  if (!R.newton.extension.empty()) extension = std::move(R.newton.extension);
-  R.newton.extension = {};
-  const bool warm = !extension.empty();
-  R.report = final_report(S, btilde, law, R.newton, opt.tight_rtol, &extension, warm);
+  // the final check's tight residual, warm from Newton's body (or, if
+  // Newton did not run, the guess at u0), also recovers the body
+  if (!R.newton.body.empty()) body = std::move(R.newton.body);
+  R.newton.body = {};
+  R.report = final_report(S, law, R.newton, opt.tight_rtol, &body);
   if (S.distributed()) {
     // the run's results for every contact node on every rank (outputs, the
     // next finer mesh of nested iteration)
     NewtonResult& N = R.newton;
     N.u = S.whole(N.u, 3);
     N.lambda = S.whole(N.lambda, 1);
-    N.Su = S.whole(N.Su, 3);
+    N.r = S.whole(N.r, 3);
     N.status = S.whole(N.status);
     N.phi = S.whole(N.phi, 1);
     if (!N.scale.empty()) N.scale = S.whole(N.scale, 1);
@@ -197,11 +201,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.contact = std::move(law);
   R.slab = S.distributed() ? S.slab() : make_slab(R.problem->grid, 0, 1);
   if (opt.recover_interior) {
-    R.u_full = std::move(extension);
-    axpy(index(R.u_full.size()), 1, R.interior_load.data(), R.u_full.data());
+    R.u_full = std::move(body);
     S.exchange_ghosts(R.u_full.data());  // its ghost rows too (output pieces)
-  } else {
-    R.interior_load = {};
   }
   const double t4 = wall_time();
   if (opt.phase_done) opt.phase_done("final check and recovery", t4 - t3);
@@ -238,8 +239,9 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
       f.newton.scaling = paper.scaling;
       f.newton.forcing_max = paper.forcing_max;
       f.newton.u0 = f.newton.lambda0 = nullptr;
-      f.newton.Su0 = nullptr;
-      f.newton.extension0 = nullptr;
+      f.newton.r0 = nullptr;
+      f.newton.body0 = nullptr;
+      f.newton.force_scale = 0;
       f.nested = false;
     }
     if (opt.phase_done)

@@ -46,7 +46,7 @@ struct RunOptions {
   std::function<void(const NestedLevel&)> nested_done;
   bool recover_interior = true;  // full 3D displacement (needed for VTK output)
   // called at every Newton iterate of the fine mesh with the body's
-  // displacement (one extra S apply per iterate, to 1e-8, not counted as
+  // displacement (one extra solve per iterate, to 1e-8, not counted as
   // solver work); for output such as --vtk-every-iteration
   std::function<void(const Iterate&)> iterate_done;
   // nested iteration (nested.hpp): coarser meshes first, down to meshes of
@@ -55,9 +55,15 @@ struct RunOptions {
   index nested_min_contact_nodes = 64;
   // the coarse meshes stop at |v̂| <= nested_rtol |v̂_0| (their solutions
   // differ from the fine one by the discretisation error anyway) and
-  // compute b̃ and S u to 1e-3 nested_rtol
+  // compute r = S u - b̃ to 1e-3 nested_rtol
   real nested_rtol = 1e-4;
   real tight_rtol = 1e-12;
+  // |b̃| (the scale of the absolute accuracies) of a run with an initial
+  // iterate, by a solve to this relative accuracy
+  real scale_rtol = 1e-3;
+  // set on a coarser mesh of nested iteration: keep K_ii^{-1} l_i (to
+  // scale_rtol) as the finer mesh's guess for its |b̃|
+  bool keep_interior_load = false;
   // the contact law per node (p values each); empty: contact_conditions(spec)
   ContactConditions contact;
   // Coulomb friction (coulomb.hpp): coefficient F >= 0 makes the bound
@@ -107,11 +113,11 @@ struct RunResult {
   FinalReport report;
   std::vector<real> u_full;         // 3N SoA (empty if not recovered); several ranks: slab's local vector
   Slab slab;                        // the rank's rows of u_full (one rank: the whole grid)
-  std::vector<real> interior_load;  // K_ii^{-1} l_i, 3N SoA (kept with u_full, for nested iteration)
+  std::vector<real> interior_load;  // K_ii^{-1} l_i to scale_rtol, 3N SoA (keep_interior_load only)
   long long inner_iterations = 0;  // over the whole run, including condensation and the final check
   // work in fine-grid matvec equivalents (the Newton phase alone is
-  // newton.fine_matvecs): the whole run, condensed load, Newton and the
-  // final tight check (which includes the recovery)
+  // newton.fine_matvecs): the whole run, |b̃|, Newton and the final tight
+  // check (which includes the recovery)
   double fine_matvecs_total = 0;
   double peak_memory = 0;  // bytes, process peak resident set after the run (several ranks: the largest)
   // the coarse meshes of nested iteration, coarsest first (empty: cold start);

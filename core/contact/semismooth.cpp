@@ -41,6 +41,14 @@ struct InnerWork {
     fine_matvecs += S.apply_work(st.iterations);
     return st.ok();
   }
+  // r = S u - b̃ (SteklovPoincare::residual), counted the same way
+  bool residual(const SteklovPoincare& S, const real* u, real* r, real rtol, real* body, const real* guess) {
+    const SolveStats st = S.residual(u, r, rtol, body, guess);
+    iterations += st.iterations;
+    failures += st.ok() ? 0 : 1;
+    fine_matvecs += S.apply_work(st.iterations);
+    return st.ok();
+  }
 };
 
 // The reduced Newton system of one step (method.md §4).
@@ -254,19 +262,21 @@ bool stagnated(const std::vector<real>& h, int w) {
   return last > 0.5 * before;
 }
 
-NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde,
-                               const ContactConditions& given, const NewtonOptions& opt) {
+NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt) {
   // Coulomb (opt.coulomb >= 0): the bound follows lambda at every iteration
   ContactConditions law = given;
   const double t0 = wall_time();
-  const index p = S.size() / 3, n3 = 3 * p;
+  const index p = S.size() / 3, n3 = 3 * p, nf = S.full_size();
   auto size_error = [&](const char* what, size_t got, index want) {
     throw std::invalid_argument(std::string("semismooth_newton: ") + what + " has " + std::to_string(got) +
                                 " entries, expected " + std::to_string(want));
   };
-  if (index(btilde.size()) != n3) size_error("b~", btilde.size(), n3);
   if (opt.u0 && index(opt.u0->size()) != n3) size_error("u0", opt.u0->size(), n3);
   if (opt.lambda0 && index(opt.lambda0->size()) != p) size_error("lambda0", opt.lambda0->size(), p);
+  if (opt.r0 && index(opt.r0->size()) != n3) size_error("r0", opt.r0->size(), n3);
+  if (opt.body0 && index(opt.body0->size()) != nf) size_error("body0", opt.body0->size(), nf);
+  if (opt.r0 && !(opt.body0 && opt.force_scale > 0))
+    throw std::invalid_argument("semismooth_newton: r0 needs the body it came from (body0) and force_scale");
   const std::vector<real>& phi = law.phi;
   if (index(phi.size()) != p) size_error("phi", phi.size(), p);
   if (index(law.gap.size()) != p) size_error("gap", law.gap.size(), p);
@@ -282,7 +292,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
   NewtonResult R;
   R.u.assign(n3, 0);
   R.lambda.assign(p, 0);
-  R.Su.assign(n3, 0);
+  R.r.assign(n3, 0);
   R.status.assign(p, 0);
   // the approximation step's metric (contact_maps.hpp): the paper's (s = 1) or
   // s_i = mean diagonal of K_cc at contact node i; kept in the result for
@@ -296,30 +306,36 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     R.fine_matvecs = work.fine_matvecs;
     return R;
   };
-  if (opt.Su0 && index(opt.Su0->size()) != n3) size_error("Su0", opt.Su0->size(), n3);
-  // E u, tracked with S u: the warm start of every bookkeeping apply's
-  // solve and, on return, of the final check's
-  R.extension.assign(S.full_size(), 0);
-  if (opt.extension0 && index(opt.extension0->size()) != S.full_size())
-    size_error("extension0", opt.extension0->size(), S.full_size());
-  if (opt.u0 && opt.lambda0) {
-    R.u = *opt.u0;
-    R.lambda = *opt.lambda0;
-    if (opt.extension0) R.extension = *opt.extension0;
-    if (opt.Su0) {
-      R.Su = *opt.Su0;
-    } else {
-      // S u0 starts the bookkeeping of S u: the same accuracy as every S Δu
-      R.operator_applications += 1;
-      real* ext = R.extension.data();
-      if (!work.apply(S, R.u.data(), R.Su.data(), std::max(opt.book_accuracy, real(1e-12)), ext,
-                      opt.extension0 ? ext : nullptr))
-        return finish(NewtonReason::inner_failure);
-    }
+  if (opt.u0) R.u = *opt.u0;
+  if (opt.lambda0) R.lambda = *opt.lambda0;
+  if (opt.body0)
+    R.body = *opt.body0;
+  else
+    R.body.assign(nf, 0);
+  // r = S u - b̃ to the accuracy its use needs (Tolerances): r_err is an
+  // absolute bound of the error of the current r that a fresh solve, warm
+  // from the body, brings down (refresh)
+  real r_err = INFINITY;
+  auto refresh = [&](real rtol) {
+    R.operator_applications += 1;
+    return work.residual(S, R.u.data(), R.r.data(), std::max(rtol, real(1e-12)), R.body.data(), R.body.data());
+  };
+  R.force_scale = opt.force_scale;
+  if (opt.r0) {
+    R.r = *opt.r0;
+  } else if (!refresh(opt.initial_residual_rtol)) {
+    return finish(NewtonReason::inner_failure);
   }
-  const index nf = S.full_size();
+  if (!(R.force_scale > 0)) {
+    if (opt.u0) throw std::invalid_argument("semismooth_newton: an initial iterate u0 needs force_scale = |b~|");
+    R.force_scale = std::sqrt(S.sum(dot(n3, R.r.data(), R.r.data())));  // x0 = 0: r0 = -b̃
+    if (!(R.force_scale > 0)) R.force_scale = 1;                         // no load at all
+  }
+  r_err = opt.r0 ? opt.residual_accuracy * R.force_scale : opt.initial_residual_rtol * R.force_scale;
+  const real fscale = R.force_scale;
+
   // side: [S Δu | E Δu] of the step; known_side: the same of its known increments
-  std::vector<real> r(n3), v(4 * p), d(3 * p), du(n3), side(n3 + nf), known_side(n3 + nf);
+  std::vector<real> v(4 * p), d(3 * p), du(n3), side(n3 + nf), known_side(n3 + nf);
   std::vector<real> v_at_d(opt.coulomb_newton ? 4 * p : 0);  // (Coulomb Newton: the second step's v̂, not used)
   ReducedSystem L(n3);
   std::unique_ptr<BoundaryPreconditioner> M;
@@ -327,39 +343,67 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     M = std::make_unique<BoundaryPreconditioner>(S, S.mg_options());
   CGWorkspace ws;
   const real* scale_ptr = scale.empty() ? nullptr : scale.data();
-  real smax = 0;  // Coulomb Newton: bounds |S Δu| by smax |Δu| for the bookkeeping apply
+  real smax = 0;  // Coulomb Newton: bounds |S Δu| by smax |Δu| for the increment's accuracy
   if (opt.coulomb_newton) {
-    for (real s : (scale.empty() ? step_scale(S) : scale)) smax = std::max(smax, s);
+    for (real sc : (scale.empty() ? step_scale(S) : scale)) smax = std::max(smax, sc);
     smax = S.max(smax);
   }
 
-  const real bnorm = std::sqrt(S.sum(dot(n3, btilde.data(), btilde.data())));
   bool last_step_hit_limit = false;
   real eta = opt.forcing_max;
   for (int k = 0;; ++k) {
-    // 1. approximation step at x = (u, lambda), r = S u - b̃
-    real vnorm;
-    {
-      ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
-      for (index i = 0; i < n3; ++i) r[i] = R.Su[i] - btilde[i];
-      if (opt.coulomb >= 0)
-        for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * std::max(real(0), R.lambda[i]);
-      vnorm = std::sqrt(S.sum(approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), r.data(), v.data(),
-                                                 d.data(), R.status.data())));
-      if (opt.coulomb >= 0 && opt.coulomb_newton) {
-        // the step's point on the Coulomb graph: its pressure d_4 sets the
-        // bound of its friction force (v̂, the residual, stays at lambda)
-        for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * d[2 * p + i];
-        approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), r.data(), v_at_d.data(), d.data(),
-                           R.status.data());
+    // 1. approximation step at x = (u, lambda), r = S u - b̃, and the step's
+    // forcing term; r is refreshed first if it is not accurate enough for
+    // them (Tolerances)
+    real vnorm, eta_k, tol;
+    for (int pass = 0;; ++pass) {
+      {
+        ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
+        if (opt.coulomb >= 0)
+          for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * std::max(real(0), R.lambda[i]);
+        vnorm = std::sqrt(S.sum(approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), R.r.data(),
+                                                   v.data(), d.data(), R.status.data())));
+        if (opt.coulomb >= 0 && opt.coulomb_newton) {
+          // the step's point on the Coulomb graph: its pressure d_4 sets the
+          // bound of its friction force (v̂, the residual, stays at lambda)
+          for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * d[2 * p + i];
+          approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), R.r.data(), v_at_d.data(),
+                             d.data(), R.status.data());
+        }
       }
+      tol = std::max(opt.eps, opt.rtol * (k == 0 ? vnorm : R.history[0]));
+      // Forcing term (Eisenstat–Walker, choice 2, safeguarded): the step is
+      // solved to eta_k relative, eta_k -> 0 as |v̂| falls (superlinear) ...
+      eta_k = eta;
+      if (k > 0) {
+        const real ratio = vnorm / R.history[k - 1];
+        eta_k = std::min(opt.forcing_max, real(0.9) * ratio * ratio);
+        if (0.9 * eta * eta > 0.1) eta_k = std::max(eta_k, real(0.9) * eta * eta);
+      }
+      // ... but no finer than the stopping rule needs: a step that reduces
+      // |v̂| by about tol/|v̂| is enough to stop after it (Kelley's safeguard
+      // against oversolving the last step, here with the factor 0.1: 0.5 left
+      // the 12x6x6 dense-reference case at 1.15e-6 > eps; measured: 16-21 %
+      // less Coulomb work at levels 8-11, where the last step's eta fell to
+      // 1e-8; Tresca the same)
+      eta_k = std::min(opt.forcing_max, std::max(eta_k, real(0.1) * tol / vnorm));
+      // r must be accurate to a fraction of what the step resolves, and to
+      // the full accuracy before |v̂| <= tol is believed
+      const real need = vnorm <= tol ? opt.residual_accuracy * fscale
+                                     : std::max(opt.residual_accuracy * fscale, opt.residual_fraction * eta_k * vnorm);
+      // (a refresh lowers |v̂| where r's error was most of it, and so the
+      // need: a few passes, each continuing the last solve)
+      if (r_err <= need || pass == 6 || !std::isfinite(vnorm)) break;
+      if (!refresh(need / fscale)) return finish(NewtonReason::inner_failure);
+      r_err = need;
     }
+    eta = eta_k;
     R.history.push_back(vnorm);
     R.inner_history.push_back(work.iterations);
     R.outer_history.push_back(R.outer_iterations);
     if (opt.progress) {
       NewtonProgress pr{k, vnorm, 0, 0, 0, 0, work.iterations, R.outer_iterations, wall_time() - t0,
-                        &R.u, &R.lambda, &r, &R.status, &law.phi};
+                        &R.u, &R.lambda, &R.r, &R.status, &law.phi};
       for (index i = 0; i < p; ++i) {
         (R.status[i] & kContact ? pr.active : pr.separated) += 1;
         (R.status[i] & kStick ? pr.sticking : pr.sliding) += 1;
@@ -371,7 +415,6 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
       opt.progress(pr);
     }
     if (!std::isfinite(vnorm)) return finish(NewtonReason::non_finite);
-    const real tol = std::max(opt.eps, opt.rtol * R.history[0]);
     if (vnorm <= tol) return finish(NewtonReason::converged);
     if (k >= opt.max_iterations) return finish(NewtonReason::iteration_limit);
     if (stagnated(R.history, opt.stagnation_window)) return finish(NewtonReason::stagnation);
@@ -382,20 +425,6 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
                                            opt.coulomb >= 0 && opt.coulomb_newton ? opt.coulomb : real(-1), L)
                                      ? 1
                                      : 0) > 0;
-    // Forcing term (Eisenstat–Walker, choice 2, safeguarded): the step is
-    // solved to eta_k relative, eta_k -> 0 as |v̂| falls (superlinear).
-    if (k > 0) {
-      const real ratio = vnorm / R.history[k - 1], prev = eta;
-      eta = std::min(opt.forcing_max, real(0.9) * ratio * ratio);
-      if (0.9 * prev * prev > 0.1) eta = std::max(eta, real(0.9) * prev * prev);
-    }
-    // ... but no finer than the stopping rule needs: a step that reduces
-    // |v̂| by about tol/|v̂| is enough to stop after it (Kelley's safeguard
-    // against oversolving the last step, here with the factor 0.1: 0.5 left
-    // the 12x6x6 dense-reference case at 1.15e-6 > eps; measured: 16-21 %
-    // less Coulomb work at levels 8-11, where the last step's eta fell to
-    // 1e-8; Tresca the same)
-    eta = std::min(opt.forcing_max, std::max(eta, real(0.1) * tol / vnorm));
 
     // 3. the reduced Newton system, by preconditioned CG on the boundary
     const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * tol, any_known, work, ws, du, side, known_side);
@@ -409,26 +438,29 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>
     if (limit && last_step_hit_limit) return finish(NewtonReason::outer_failure);
     last_step_hit_limit = limit;
 
-    // 4. update x = (u, lambda), S u and E u. The step may be inexact, but
-    // S Δu must be accurate: S u is kept incrementally and its error stays
-    // in every later residual. One application of S to the whole Δu, to an
-    // absolute accuracy of book_accuracy |b̃| (relative to the CG's estimate
-    // of S Δu), its inner solve warm from the CG's running E Δu.
+    // 4. update x = (u, lambda), r = S u - b̃ and the body. The step may be
+    // inexact, but S Δu must be as accurate as this step's r (its error
+    // stays in every later r): one application of S to the whole Δu, its
+    // inner solve warm from the CG's running E Δu, to an absolute accuracy
+    // of max(residual_accuracy |b̃|, residual_fraction eta_k |v̂_k|). An
+    // increment has the rounding error of its own size, not of r's, so r is
+    // kept by increments and refreshed only where it is too loose.
     for (index i = 0; i < n3; ++i) du[i] += L.known[i];
     real* Sdu = side.data();
     real* Edu = side.data() + n3;
+    const real accuracy = std::max(opt.residual_accuracy * fscale, opt.residual_fraction * eta * vnorm);
     // |S Δu| from the CG's side product, or (GMRES) bounded by max s |Δu|
     const real sdu_norm = L.coupled ? smax * std::sqrt(S.sum(dot(n3, du.data(), du.data())))
                                     : std::sqrt(S.sum(dot(n3, Sdu, Sdu)));
-    const real book_rtol =
-        sdu_norm > 0 ? std::clamp(opt.book_accuracy * bnorm / sdu_norm, real(1e-12), real(1e-1)) : real(1e-1);
+    const real inc_rtol = sdu_norm > 0 ? std::clamp(accuracy / sdu_norm, real(1e-12), real(1e-1)) : real(1e-1);
     R.operator_applications += 1;
-    if (!work.apply(S, du.data(), Sdu, book_rtol, Edu, Edu)) return finish(NewtonReason::inner_failure);
+    if (!work.apply(S, du.data(), Sdu, inc_rtol, Edu, Edu)) return finish(NewtonReason::inner_failure);
+    r_err = std::max(r_err, accuracy);
     for (index i = 0; i < p; ++i)
       R.lambda[i] += L.dlambda[i] + ((R.status[i] & kContact) ? Sdu[2 * p + i] : 0);
     axpy(n3, 1, du.data(), R.u.data());
-    axpy(n3, 1, Sdu, R.Su.data());
-    axpy(nf, 1, Edu, R.extension.data());
+    axpy(n3, 1, Sdu, R.r.data());
+    axpy(nf, 1, Edu, R.body.data());
     R.iterations = k + 1;
   }
 }

@@ -1,7 +1,8 @@
 // Semismooth* Newton method for the condensed Tresca contact problem
 // (paper Section 4, method.md §3–5), matrix-free on the contact boundary.
 //
-// Iteration k, x = (u, lambda), r = S u − b̃ kept current incrementally:
+// Iteration k, x = (u, lambda), r = S u − b̃ (the contact forces that hold
+// the body at u) and the body's displacement U = E u + K_ii^{-1} l_i:
 //  1. approximation step (kernels/contact_maps.hpp) at scale s → d̂, node
 //     status; the paper's v̂ (s = 1) for the stopping rule ||v̂||_2 <= eps (11);
 //  2. Newton step (9)–(10) in reduced form, with v = d̂ − x the step's
@@ -12,21 +13,29 @@
 //     with r = (s I + H_1) v_12 on sliding rows, v_3 + v_4 on separated rows,
 //     by CG preconditioned with BoundaryPreconditioner; then
 //     Δλ = (S Δu)_z − v_3 on contact nodes.
-//  3. S u += S Δu, with S Δu from one application of S to the whole step.
+//  3. r += S Δu, U += E Δu, from one application of S to the whole step,
+//     warm from the outer CG's running E Δu.
 // Tolerances. The step is inexact: CG stops at eta_k |r_F| (forcing term,
 // Eisenstat–Walker choice 2: eta_0 = forcing_max, then 0.9 (|v̂_k|/|v̂_k-1|)²,
 // safeguarded, so eta_k -> 0 and the convergence stays superlinear), floored
 // at 0.1 eps. Its inner (K_ii) solves are relaxed as the outer residual r_j
 // falls: inner rtol_j = clamp(target / ||r_j||, 1e-12, 1e-2) (a safety factor 0.1 cost
-// 6-13% more work and saved no Newton step, perf/RESULTS.md §0c). S Δu for
-// the bookkeeping of S u must be accurate whatever eta (its error stays in
-// every later residual): to book_accuracy |b̃| absolute, i.e. a tight solve
-// for the large early steps and a loose one for the small late ones.
+// 6-13% more work and saved no Newton step, perf/RESULTS.md §0c). The
+// residual r needs the accuracy of its use: residual_fraction eta_k |v̂_k|
+// absolute for the step it decides (an error of that size is a part of the
+// step's own inexactness), and residual_accuracy |b̃| before |v̂| <= eps is
+// believed. The first r is loose (one solve, SteklovPoincare::residual: a
+// nested or restarted x0 is far from the solution in |v̂|); each S Δu is
+// solved to the accuracy of its step; where r is too loose for its use it
+// is refreshed by a solve warm from U, which only corrects. Increments keep
+// r near convergence: a fresh r has the rounding error of r itself (~1e-13
+// |b̃|), an increment that of the increment.
 // The paper's unscaled step compares forces with displacements (1 N against
 // nodal forces of 1e7 N), so an error of 1e-8 in a force moves its decisions:
 // it needs eta = 1e-10 (NewtonOptions::paper_method()). The scaled step
 // compares both in consistent units and takes eta_0 = 1e-2.
-// Cost per step: outer iterations + 2 S applications = inner MG-CG solves.
+// Cost per step: outer iterations + 2 S applications (known increments,
+// S Δu) = inner MG-CG solves, and now and then a refresh of r.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -75,7 +84,12 @@ struct NewtonOptions {
   int max_iterations = 50;
   StepScaling scaling = StepScaling::diagonal;
   real forcing_max = 1e-2;     // largest relative accuracy of a Newton step (the first)
-  real book_accuracy = 1e-12;  // absolute accuracy of each S Δu, relative to |b̃|
+  // accuracy of r = S u - b̃ (relative to |b̃|, absolute): at convergence,
+  // and as a fraction of eta_k |v̂_k| before (Tolerances); the first r,
+  // relative to its right-hand side
+  real residual_accuracy = 1e-12;
+  real residual_fraction = 0.1;
+  real initial_residual_rtol = 1e-4;
   // stop when the largest ||v̂|| of the last `stagnation_window` steps is not
   // below half the largest of the window before (a lucky dip does not count)
   int stagnation_window = 4;
@@ -88,16 +102,18 @@ struct NewtonOptions {
     o.forcing_max = 1e-10;
     return o;
   }
-  // optional initial iterate (default x0 = 0): u0 (3p) and lambda0 (p);
-  // S u0 is then formed with a tight inner solve
+  // optional initial iterate (default x0 = 0): u0 (3p) and lambda0 (p)
   const std::vector<real>* u0 = nullptr;
   const std::vector<real>* lambda0 = nullptr;
-  // optional, with u0: E u0 (S.full_size(), steklov.hpp): with Su0 E u0
-  // itself, else the initial guess of the S u0 solve
-  const std::vector<real>* extension0 = nullptr;
-  // optional, with u0: S u0 itself (3p), e.g. the tracked S u of an earlier
-  // solve from which this one continues; then no solve is needed for it
-  const std::vector<real>* Su0 = nullptr;
+  // optional: a guess of the body's displacement at u0 (S.full_size(),
+  // steklov.hpp: residual), e.g. a coarser mesh's, interpolated
+  const std::vector<real>* body0 = nullptr;
+  // |b̃| [N], the scale of r's absolute accuracy; 0: |r| at x0 = 0 (= |b̃|).
+  // Required with u0 (e.g. from a loose SteklovPoincare::condensed_load).
+  real force_scale = 0;
+  // optional, with body0 and force_scale: r0 = S u0 - b̃ of that body to
+  // residual_accuracy, e.g. an earlier solve's NewtonResult::r and ::body
+  const std::vector<real>* r0 = nullptr;
   // Coulomb with the bound lagged by one step: F >= 0 sets phi_i = F lambda_i
   // of the current iterate before every approximation step (the law's phi is
   // then ignored). ||v̂|| with that bound is the Coulomb problem's own
@@ -116,8 +132,9 @@ struct NewtonResult {
   int iterations = 0;                  // Newton steps taken
   std::vector<real> history;           // ||v̂|| after each approximation step (first at x0)
   std::vector<long long> inner_history, outer_history;  // cumulative inner / outer CG iterations there
-  std::vector<real> u, lambda, Su;     // 3p, p, 3p
-  std::vector<real> extension;         // E u (S.full_size()), tracked with S u to the same accuracy
+  std::vector<real> u, lambda, r;      // 3p, p, 3p: r = S u - b̃ (to residual_accuracy if converged)
+  std::vector<real> body;              // U = E u + K_ii^{-1} l_i (S.full_size()) of that r
+  real force_scale = 0;                // |b̃| used for the accuracies
   std::vector<std::uint8_t> status;    // per node: kContact | kStick at the last approximation step
   std::vector<real> phi;               // the Tresca bound of the last approximation step
   std::vector<real> scale;             // the steps' metric s_i (step_scale), empty: the paper's (s = 1)
@@ -149,7 +166,6 @@ struct ContactConditions {
 // (perf/RESULTS.md), so the plain diagonal of K_cc it is
 std::vector<real> step_scale(const SteklovPoincare& S);
 
-NewtonResult semismooth_newton(const SteklovPoincare& S, const std::vector<real>& btilde, const ContactConditions& law,
-                               const NewtonOptions& opt);
+NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& law, const NewtonOptions& opt);
 
 }  // namespace tresca

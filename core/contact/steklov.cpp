@@ -149,6 +149,30 @@ void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
 }
 
 SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* extension, const real* guess) const {
+  return extend(v, nullptr, Sv, rtol, extension, guess);
+}
+
+SolveStats SteklovPoincare::residual(const real* u, real* r, real rtol, real* body, const real* guess) const {
+  // the load on this rank's rows (all of it on one rank); its interior part
+  // is the solve's right-hand side besides -K_ic u
+  std::vector<real> load;
+  if (dmg_) {
+    load.assign(full_size(), 0);
+    global_to_local(slab(), P_.load.data(), load.data());
+  } else {
+    load = P_.load;
+  }
+  std::vector<real> lc(3 * p_);
+  gather(load.data(), lc.data());
+  zero_constrained(box(), dmg_ ? slab().local_faces(P_.interior_faces) : P_.interior_faces, load.data());
+  if (dmg_) Kd_->zero_ghosts(load.data());
+  const SolveStats st = extend(u, load.data(), r, rtol, body, guess);
+  for (index i = 0; i < 3 * p_; ++i) r[i] -= lc[i];
+  return st;
+}
+
+SolveStats SteklovPoincare::extend(const real* v, real* li, real* out, real rtol, real* extension,
+                                   const real* guess) const {
   // Invariants between calls: w_ is zero off the contact nodes, t_ is zero
   // off plane 1, so only plane-sized work surrounds the inner solve.
   const GridDims& g = box();
@@ -157,12 +181,15 @@ SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* exte
   // t = -K_ic v lives on plane 1 (w_ is zero on the x = 0 nodes, so are t's)
   apply_planes(w_.data(), t_.data(), 1, 2);
   for (int a = 0; a < 3; ++a) scale(plane, -1, t_.data() + a * N + plane);
-  const SolveStats st = solve_interior(t_.data(), z_.data(), rtol, guess);
+  // right-hand side -K_ic v, or l_i - K_ic v in li itself
+  if (li)
+    for (int a = 0; a < 3; ++a) axpy(plane, 1, t_.data() + a * N + plane, li + a * N + plane);
+  const SolveStats st = solve_interior(li ? li : t_.data(), z_.data(), rtol, guess);
   // u = w + z: z vanishes on the constrained plane 0, where w lives
   set_plane(z_.data(), 0, w_.data());
-  // Sv = (K u)_c on plane 0, then restore t_'s invariant
+  // (K u)_c on plane 0, then restore t_'s invariant
   apply_planes(z_.data(), t_.data(), 0, 1);
-  gather(t_.data(), Sv);
+  gather(t_.data(), out);
   set_plane(t_.data(), 0, nullptr);
   if (extension) copy(3 * N, z_.data(), extension);
   return st;
@@ -175,26 +202,12 @@ double SteklovPoincare::apply_work(long long inner_iterations) const {
 
 SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior,
                                            const real* guess) const {
-  // the load on this rank's rows (all of it on one rank)
-  std::vector<real> load;
-  if (dmg_) {
-    load.assign(full_size(), 0);
-    global_to_local(slab(), P_.load.data(), load.data());
-  } else {
-    load = P_.load;
-  }
-  std::vector<real> li(load);
-  zero_constrained(box(), dmg_ ? slab().local_faces(P_.interior_faces) : P_.interior_faces, li.data());
-  if (dmg_) Kd_->zero_ghosts(li.data());
-  const SolveStats st = solve_interior(li.data(), z_.data(), rtol, guess);
-  apply_planes(z_.data(), t_.data(), 0, 1);
-  std::vector<real> lc(3 * p_);
+  // b̃ = -(S 0 - b̃)
+  const std::vector<real> zero(3 * p_, 0.0);
   b.resize(3 * p_);
-  gather(t_.data(), b.data());
-  set_plane(t_.data(), 0, nullptr);
-  gather(load.data(), lc.data());
-  for (index i = 0; i < 3 * p_; ++i) b[i] = lc[i] - b[i];
-  if (interior) interior->assign(z_.begin(), z_.end());
+  if (interior) interior->resize(full_size());
+  const SolveStats st = residual(zero.data(), b.data(), rtol, interior ? interior->data() : nullptr, guess);
+  for (real& x : b) x = -x;
   return st;
 }
 

@@ -79,7 +79,14 @@ class SteklovPoincare {
   // contact face, the discrete harmonic extension inside, 0 on x = 0). guess
   // (3N, may be `extension` itself): initial guess of E v for the inner solve.
   SolveStats apply(const real* v, real* Sv, real rtol, real* extension = nullptr, const real* guess = nullptr) const;
-  // b = b̃ (3p) with the inner solve to relative tolerance rtol; with
+  // r = S u − b̃ (3p) with one inner solve, K_ii y = l_i − K_ic u, to
+  // relative tolerance rtol: the contact forces that hold the body at u on
+  // the contact face. With `body`, also the body's displacement there (u on
+  // the face, y inside: E u + K_ii^{-1} l_i). guess (may be `body`): initial
+  // guess of the body, e.g. the last one moved by E Δu: the solve then only
+  // corrects, and the residual is true to rtol whatever the guess.
+  SolveStats residual(const real* u, real* r, real rtol, real* body = nullptr, const real* guess = nullptr) const;
+  // b = b̃ = -residual(0) (3p) with the inner solve to relative tolerance rtol; with
   // `interior`, also K_ii^{-1} l_i there (3N SoA). The body's displacement
   // for contact values u_c is then E u_c + K_ii^{-1} l_i: recovery costs no
   // solve beyond the final check's S u_c.
@@ -101,6 +108,10 @@ class SteklovPoincare {
 
  private:
   SolveStats solve_interior(const real* rhs, real* z, real rtol, const real* guess = nullptr) const;
+  // out = (K x)_c for x = v on the contact face and z inside, where
+  // K_ii z = −K_ic v, or with li (the interior load, 3D, overwritten)
+  // K_ii z = l_i − K_ic v; x into `extension` if given
+  SolveStats extend(const real* v, real* li, real* out, real rtol, real* extension, const real* guess) const;
   // plane iz of all 3 components of v := src's (or 0 if src is null)
   void set_plane(real* v, index iz, const real* src) const;
   void apply_planes(const real* x, real* y, index z_begin, index z_end) const;
