@@ -173,6 +173,7 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
 struct StepOutcome {
   SolveStats outer;
   bool inner_failed = false;
+  bool known_applied = false;  // S was applied to the known increments
 };
 
 // Solves the reduced system of L for Δu_F (into du) to the relative
@@ -180,17 +181,26 @@ struct StepOutcome {
 // absolute `floor`; side gets the CG's running estimates [S Δu | E Δu] of the
 // whole step (known increments included; inexact; GMRES: the known part only).
 StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreconditioner* M, real eta, real floor,
-                       bool any_known, InnerWork& work, CGWorkspace& ws, std::vector<real>& du,
+                       real s_bound, bool any_known, InnerWork& work, CGWorkspace& ws, std::vector<real>& du,
                        std::vector<real>& side, std::vector<real>& known_side) {
   const index n3 = S.size(), nf = S.full_size();
   real* scratch = known_side.data();  // S Δu_known, then E Δu_known
   StepOutcome out;
   const long long fails0 = work.failures;
+  auto norm = [&](const real* x) { return std::sqrt(S.sum(dot(n3, x, x))); };
   // known increments enter the right-hand side: r_F -= (S Δu_known)_F; an
-  // error there is an error of the step, so the inner accuracy follows eta
+  // error there is an error of the step: to a tenth of the step's target
+  // eta |r_F| absolute, with |S Δu_known| <= s_bound |Δu_known|. Known
+  // increments too small to matter at that accuracy (e.g. u_z already on
+  // the obstacle) are not applied: the update's apply of S Δu has them.
+  // (Coulomb Newton: the coupling F t (S Δu_known)_z too, at 0.1 eta.)
   const real inner_max = 1e-2;
-  if (any_known) {
-    if (!work.apply(S, L.known.data(), scratch, std::clamp(0.1 * eta, real(1e-12), inner_max), scratch + n3)) {
+  const real known_bound = any_known ? s_bound * norm(L.known.data()) : 0;
+  const real known_accuracy = 0.1 * std::max(floor, eta * norm(L.rhs.data()));
+  out.known_applied = any_known && (L.coupled || known_bound > known_accuracy);
+  if (out.known_applied) {
+    const real rtol = L.coupled ? 0.1 * eta : known_accuracy / known_bound;
+    if (!work.apply(S, L.known.data(), scratch, std::clamp(rtol, real(1e-12), inner_max), scratch + n3)) {
       out.inner_failed = true;
       return out;
     }
@@ -208,7 +218,7 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
   if (M) M->update(L.h, L.fixed, L.free);
   ReducedNewtonOperator A(S, L, work);
   CGOptions co;
-  const real target = std::max(floor, eta * std::sqrt(S.sum(dot(n3, L.rhs.data(), L.rhs.data()))));
+  const real target = std::max(floor, eta * norm(L.rhs.data()));
   co.rtol = 1e-13;  // attainable floor relative to |rhs|
   co.atol = target;
   co.max_iterations = M ? 200 : 5000;
@@ -343,11 +353,12 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
     M = std::make_unique<BoundaryPreconditioner>(S, S.mg_options());
   CGWorkspace ws;
   const real* scale_ptr = scale.empty() ? nullptr : scale.data();
-  real smax = 0;  // Coulomb Newton: bounds |S Δu| by smax |Δu| for the increment's accuracy
-  if (opt.coulomb_newton) {
-    for (real sc : (scale.empty() ? step_scale(S) : scale)) smax = std::max(smax, sc);
-    smax = S.max(smax);
-  }
+  // |S x| <= smax |x|: S <= K_cc, whose largest eigenvalue is below 4 times
+  // its largest diagonal entry (Gershgorin: the off-diagonal row sums of the
+  // Q1 elasticity stencil are 2-3 times the diagonal)
+  real smax = 0;
+  for (real sc : (scale.empty() ? step_scale(S) : scale)) smax = std::max(smax, sc);
+  smax = 4 * S.max(smax);
 
   bool last_step_hit_limit = false;
   real eta = opt.forcing_max;
@@ -427,9 +438,10 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
                                      : 0) > 0;
 
     // 3. the reduced Newton system, by preconditioned CG on the boundary
-    const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * tol, any_known, work, ws, du, side, known_side);
+    const StepOutcome step =
+        solve_step(S, L, M.get(), eta, 0.1 * tol, smax, any_known, work, ws, du, side, known_side);
     R.outer_iterations += step.outer.iterations;
-    R.operator_applications += step.outer.iterations + (any_known ? 1 : 0);
+    R.operator_applications += step.outer.iterations + (step.known_applied ? 1 : 0);
     if (step.inner_failed) return finish(NewtonReason::inner_failure);
     if (step.outer.reason == SolveReason::non_finite) return finish(NewtonReason::non_finite);
     if (step.outer.reason == SolveReason::breakdown) return finish(NewtonReason::inner_failure);
