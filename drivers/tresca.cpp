@@ -386,7 +386,7 @@ int main(int argc, char** argv) {
     std::printf("%s after %d Newton iterations (reason: %s), final |v| %s (eps %.1e)\n",
                 N.converged() ? "converged" : "NOT CONVERGED", N.iterations, to_string(N.reason), last,
                 opt.newton.eps);
-    std::printf("true residual (fresh S u): %.3e absolute, %.3e relative to |b| = %.3e\n", F.true_residual,
+    std::printf("true residual (fresh S u - b~): %.3e absolute, %.3e relative to |b| = %.3e\n", F.true_residual,
                 F.true_residual_relative, F.btilde_norm);
     if (N.reason == NewtonReason::stagnation && !N.history.empty() && N.history.back() <= 1e-9 * N.history.front())
       std::printf("note: |v| stagnated at %.1e of its initial value, the accuracy the inner solves attain: eps = %.1e\n"
@@ -396,6 +396,10 @@ int main(int argc, char** argv) {
     if (N.converged() && !(F.true_residual <= opt.newton.eps))
       std::printf("note: the true residual is above eps = %.1e = %.1e |b|, finer than the inner solves resolve (~1e-12 |b|)\n",
                   opt.newton.eps, opt.newton.eps / F.btilde_norm);
+    else if (N.converged() && F.resolution > opt.newton.eps)
+      std::printf("note: eps = %.1e is finer than the check resolves (the body's equilibrium to %.0e: r to ~%.1e N);\n"
+                  "      the true residual is consistent with eps, not a proof of it\n",
+                  opt.newton.eps, F.resolution / F.btilde_norm, F.resolution);
     std::printf("KKT: equilibrium %.2e N, uz<0 %.2e m, lambda<0 %.2e N, lambda*uz %.2e Nm, |r_t|-phi %.2e N, direction %.2e N, stick slip %.2e m\n",
                 F.equilibrium, F.uz_violation, F.lambda_violation, F.complementarity, F.friction_bound,
                 F.friction_direction, F.stick_slip);

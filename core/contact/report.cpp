@@ -27,6 +27,7 @@ FinalReport final_report(const SteklovPoincare& S, const ContactConditions& law,
                                                        R.u.data(), R.lambda.data(), F.r.data(), v.data(), d.data(),
                                                        F.status.data())));
   F.btilde_norm = R.force_scale;
+  F.resolution = tight_rtol * R.force_scale;
   F.true_residual_relative = F.btilde_norm > 0 ? F.true_residual / F.btilde_norm : F.true_residual;
   F.ux_min = INFINITY;
   F.uz_max = -INFINITY;

@@ -21,6 +21,9 @@ namespace tresca {
 
 struct FinalReport {
   real true_residual = 0, true_residual_relative = 0, btilde_norm = 0;  // relative to |b̃| (R.force_scale)
+  // what the check resolves: r is the contact force of a body whose interior
+  // equilibrium is verified to tight_rtol, so r is known to ~tight_rtol |b̃|
+  real resolution = 0;
   real equilibrium = 0, uz_violation = 0, lambda_violation = 0, complementarity = 0;
   real friction_bound = 0, friction_direction = 0, stick_slip = 0;
   index active = 0, separated = 0, sticking = 0, sliding = 0;

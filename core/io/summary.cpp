@@ -81,6 +81,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["true_residual"] = F.true_residual;
   j["true_residual_relative"] = F.true_residual_relative;
   j["true_residual_within_eps"] = F.true_residual <= eps;
+  j["true_residual_resolution"] = F.resolution;  // r is known to about this [N]
   j["times"] = {{"nested", R.times.nested}, {"setup", R.times.setup},   {"condense", R.times.condense},
                 {"solve", R.times.solve},   {"recover", R.times.recover}, {"total", R.times.total}};
   j["counts"] = {{"inner_iterations", R.inner_iterations},
