@@ -241,6 +241,15 @@ void compare_with_dense(const NewtonOptions& method, index ex, index ey, index e
     EXPECT_GT(F.sliding, 0);
   }
   const real fscale = F.btilde_norm;
+  // |b̃|: Newton's first residual from x0 = 0, or a loose (1e-3) solve after a coarser mesh
+  EXPECT_NEAR(fscale, D.b.norm(), 1e-3 * D.b.norm());
+  // Newton's residual r = S u - b̃ (loose at first, refreshed and kept by
+  // increments) against the final check's tight one and the dense S u - b̃
+  Eigen::VectorXd uc(3 * p);
+  for (index i = 0; i < 3 * p; ++i) uc[i] = R.newton.u[i];
+  const Eigen::VectorXd rd = D.S * uc - D.b;
+  EXPECT_LT(test::max_abs_diff(R.newton.r, F.r), 1e-10 * fscale);
+  for (index i = 0; i < 3 * p; ++i) EXPECT_NEAR(F.r[i], rd[i], 1e-9 * fscale) << "i=" << i;
   EXPECT_LT(F.equilibrium, 1e-10 * fscale);
   EXPECT_LT(F.uz_violation, 1e-12);
   EXPECT_LT(F.lambda_violation, 1e-10 * fscale);
