@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
     std::printf("# kernels: %s\n", build_info().c_str());
     std::printf("# fmv: fine-grid matvec equivalents (the solvers' work counts); fmv K_ii: one MG-CG solve of K_ii to 1e-10\n");
     std::printf("# nested iteration %s; newton, outer, inner, S-app, fmv/step: this mesh; fmv nest: the coarser meshes;\n"
-                "# fmv/solve: all of it (coarser meshes, condensed load, Newton, final check and recovery)\n",
+                "# fmv/solve: all of it (coarser meshes, |b~|, Newton, final check and recovery); condense: the loose |b~|\n",
                 nested ? "on" : "off (--no-nested)");
     if (coulomb >= 0) std::printf("# Coulomb F = %g: fp = fixed-point iterations (Tresca solves), newton = all their steps\n", coulomb);
     std::printf("%5s %3s %10s %8s %8s %8s %8s %8s %8s %4s %6s %6s %6s %6s %8s %8s %9s %8s %6s %8s %7s\n", "level", "thr",

@@ -1,8 +1,10 @@
 // One complete solve of the contact problem, with the timings of the paper's
 // Table 1 columns: setup (mesh, operators, multigrid hierarchy), condense
-// (b̃ = condensed load, keeping K_ii^{-1} l_i), solve (semismooth* Newton),
-// recover (final check: one tight S apply, whose harmonic extension gives the
-// body's displacement u = E u_c + K_ii^{-1} l_i without another solve).
+// (|b̃| by a loose solve, only when Newton starts from an initial iterate:
+// from x0 = 0 the condensed load is Newton's first residual -b̃), solve
+// (semismooth* Newton, which keeps r = S u - b̃ and the body), recover
+// (final check: r by one tight solve warm from Newton's body, which is then
+// the body's displacement u = E u_c + K_ii^{-1} l_i).
 #pragma once
 #include <functional>
 #include <memory>
