@@ -490,6 +490,27 @@ TEST(SemismoothNewton, ReportsIterationLimitHonestly) {
   EXPECT_GT(R.newton.history.back(), 1e-6);
 }
 
+TEST(SemismoothNewton, RejectsAnInitialStateWithoutItsScaleOrBody) {
+  // an initial iterate needs |b̃| (the accuracies' scale); a given residual
+  // needs the body it came from: clear errors, before any solve
+  const Problem P = make_problem(spec_for_dims(8, 4, 4));
+  const SteklovPoincare S(P);
+  const index p = P.contact_nodes();
+  const ContactConditions law = ContactConditions::uniform(p, 1, 0);
+  const std::vector<real> u0(3 * p, 0.0), l0(p, 0.0), r0(3 * p, 1.0), body(S.full_size(), 0.0);
+  NewtonOptions o;
+  o.u0 = &u0;
+  o.lambda0 = &l0;
+  EXPECT_THROW(semismooth_newton(S, law, o), std::invalid_argument);
+  o.force_scale = 1e7;
+  o.r0 = &r0;
+  EXPECT_THROW(semismooth_newton(S, law, o), std::invalid_argument);
+  o.body0 = &body;
+  const std::vector<real> short_body(7, 0.0);
+  o.body0 = &short_body;
+  EXPECT_THROW(semismooth_newton(S, law, o), std::invalid_argument);
+}
+
 TEST(SemismoothNewton, ReportsStagnationForUnattainableTolerance) {
   ProblemSpec spec = spec_for_dims(8, 4, 4);
   RunOptions o;

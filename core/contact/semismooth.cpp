@@ -322,27 +322,24 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
     R.body = *opt.body0;
   else
     R.body.assign(nf, 0);
-  // r = S u - b̃ to the accuracy its use needs (Tolerances): r_err is an
-  // absolute bound of the error of the current r that a fresh solve, warm
-  // from the body, brings down (refresh)
-  real r_err = INFINITY;
+  // r = S u - b̃ to the accuracy its use needs (Tolerances), by a solve
+  // warm from the body (refresh); r_err bounds the error of the current r
   auto refresh = [&](real rtol) {
     R.operator_applications += 1;
     return work.residual(S, R.u.data(), R.r.data(), std::max(rtol, real(1e-12)), R.body.data(), R.body.data());
   };
-  R.force_scale = opt.force_scale;
+  if (opt.u0 && !(opt.force_scale > 0))
+    throw std::invalid_argument("semismooth_newton: an initial iterate u0 needs force_scale = |b~|");
   if (opt.r0) {
     R.r = *opt.r0;
   } else if (!refresh(opt.initial_residual_rtol)) {
     return finish(NewtonReason::inner_failure);
   }
-  if (!(R.force_scale > 0)) {
-    if (opt.u0) throw std::invalid_argument("semismooth_newton: an initial iterate u0 needs force_scale = |b~|");
-    R.force_scale = std::sqrt(S.sum(dot(n3, R.r.data(), R.r.data())));  // x0 = 0: r0 = -b̃
-    if (!(R.force_scale > 0)) R.force_scale = 1;                         // no load at all
-  }
-  r_err = opt.r0 ? opt.residual_accuracy * R.force_scale : opt.initial_residual_rtol * R.force_scale;
+  // |b̃| given, or from x0 = 0, where r0 = -b̃ (1 if there is no load at all)
+  R.force_scale = opt.force_scale > 0 ? opt.force_scale : std::sqrt(S.sum(dot(n3, R.r.data(), R.r.data())));
+  if (!(R.force_scale > 0)) R.force_scale = 1;
   const real fscale = R.force_scale;
+  real r_err = (opt.r0 ? opt.residual_accuracy : opt.initial_residual_rtol) * fscale;
 
   // side: [S Δu | E Δu] of the step; known_side: the same of its known increments
   std::vector<real> v(4 * p), d(3 * p), du(n3), side(n3 + nf), known_side(n3 + nf);
