@@ -336,9 +336,9 @@ int main(int argc, char** argv) {
                   (long long)spec.nodes(), (long long)spec.contact_nodes(), (long long)spec.free_dofs(), friction,
                   to_string(spec.obstacle.kind), opt.newton.eps, threads,
                   comm.distributed() ? (" per rank x " + std::to_string(comm.size()) + " MPI ranks (y-slabs)").c_str() : "");
-      std::printf("        estimated peak memory %.2f GB%s; kernels: %s\n",
+      std::printf("        estimated peak memory %.2f GB%s; kernels: %s; %s\n",
                   estimated_memory_bytes_per_rank(spec, comm.size()) / 1e9, comm.distributed() ? " per rank" : "",
-                  build_info().c_str());
+                  build_info().c_str(), omp_wait_setting().c_str());
     }
     // --vtk-every-iteration: the iterates' files, published with the run's others
     OutputSet out;

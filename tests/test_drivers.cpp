@@ -216,6 +216,17 @@ TEST(TrescaDriver, ReportsNonConvergenceInOutputAndExitStatus) {
   EXPECT_NE(r.out.find("iteration_limit"), std::string::npos) << r.out;
 }
 
+TEST(TrescaDriver, SaysHowThreadsWaitAndKeepsTheUsersSetting) {
+  // the drivers' default: passive, with a short spin only where the cores
+  // were free at start; a user's own OMP_WAIT_POLICY is kept as it is
+  const CmdResult d = run("tresca --dims 8x4x4", "env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT");
+  const bool spin = d.out.find("OMP_WAIT_POLICY=passive, GOMP_SPINCOUNT=10000") != std::string::npos;
+  const bool sleep = d.out.find("OMP_WAIT_POLICY=passive, GOMP_SPINCOUNT=0") != std::string::npos;
+  EXPECT_TRUE(spin || sleep) << d.out;
+  const CmdResult u = run("tresca --dims 8x4x4", "env -u GOMP_SPINCOUNT OMP_WAIT_POLICY=active");
+  EXPECT_NE(u.out.find("; OMP_WAIT_POLICY=active\n"), std::string::npos) << u.out;
+}
+
 TEST(TrescaDriver, NearlyIncompressibleMaterialFailsFastAndSaysWhy) {
   // Q1 locks at nu -> 0.5 and the multigrid CGs cannot converge: the run
   // must stop at a failed solve with the reason, not hang (the loose first

@@ -2,6 +2,7 @@
 
 #include "core/parallel/comm.hpp"
 
+#include <algorithm>
 #include <utility>
 #include <omp.h>
 #include <unistd.h>
@@ -205,15 +206,54 @@ void check_memory(const ProblemSpec& s) {
   }
 }
 
+namespace {
+// Whether this run's threads find the machine's cores free at start: the
+// tasks running besides this one (/proc/loadavg, fewest of five looks 1 ms
+// apart, so that a short-lived daemon does not count) plus the threads it
+// will start fit in the cores. A snapshot: a process that starts later is
+// not seen.
+bool cores_free_at_start() {
+  long running = -1;
+  for (int look = 0; look < 5; ++look) {
+    std::ifstream in("/proc/loadavg");
+    double l1, l5, l15;
+    long r = 0, total = 0;
+    char slash;
+    if (!(in >> l1 >> l5 >> l15 >> r >> slash >> total) || r < 1) return false;
+    running = running < 0 ? r : std::min(running, r);
+    usleep(1000);
+  }
+  const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  long threads = cores;
+  if (const char* env = std::getenv("OMP_NUM_THREADS")) threads = std::strtol(env, nullptr, 10);
+  return cores > 0 && threads > 0 && (running - 1) + threads <= cores;
+}
+}  // namespace
+
 void default_runtime_environment(char** argv) {
   bool changed = false;
-  for (const auto& [name, value] : {std::pair<const char*, const char*>{"OMP_WAIT_POLICY", "passive"},
-                                    {"GLIBC_TUNABLES", "glibc.malloc.hugetlb=1"}})
+  auto set_default = [&](const char* name, const char* value) {
     if (!std::getenv(name)) {
       setenv(name, value, 0);
       changed = true;
     }
+  };
+  // idle threads wait for the next parallel region by spinning a little
+  // (10,000 spins, a few microseconds) before they sleep, but only where
+  // the cores were free at start: a spinning thread takes its core from
+  // whoever else runs there
+  if (!std::getenv("OMP_WAIT_POLICY") && !std::getenv("GOMP_SPINCOUNT"))
+    set_default("GOMP_SPINCOUNT", cores_free_at_start() ? "10000" : "0");
+  set_default("OMP_WAIT_POLICY", "passive");
+  set_default("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1");
   if (changed) execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
+}
+
+std::string omp_wait_setting() {
+  const char* policy = std::getenv("OMP_WAIT_POLICY");
+  const char* spins = std::getenv("GOMP_SPINCOUNT");
+  return std::string("OMP_WAIT_POLICY=") + (policy ? policy : "(unset)") +
+         (spins ? std::string(", GOMP_SPINCOUNT=") + spins : std::string());
 }
 
 void require_one_rank(const char* program) {

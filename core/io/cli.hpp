@@ -38,14 +38,21 @@ void check_memory(const ProblemSpec& s);
 // The drivers' runtime defaults, read by libgomp and glibc only when the
 // process starts, so if a variable is unset this re-executes the program once
 // with it set; a user's own setting is always kept. Call it first in main.
-// - OMP_WAIT_POLICY=passive: threads that wait sleep instead of spinning.
-//   Spinning is 4% faster on an idle machine at level 10, but when another
-//   process holds a core the spinning threads slow a run by 2-4x.
+// - OMP_WAIT_POLICY=passive with GOMP_SPINCOUNT=10000 where the cores were
+//   free at start (else 0): idle threads spin a few microseconds, then
+//   sleep. Measured (perf/RESULTS.md §0d): on an idle machine level 8 takes
+//   0.25-0.30 s instead of 0.37-0.48 s, level 10 1.4-1.7 s instead of
+//   1.9-2.1 s; with another process on a core spinning threads take its
+//   time (level 10: 4.0-4.6 s against 2.3-2.7 s sleeping), so a run that
+//   finds a core busy at start sleeps at once. Unless the user set either.
 // - GLIBC_TUNABLES=glibc.malloc.hugetlb=1: malloc asks for transparent huge
 //   pages (where the kernel's THP mode is "madvise", as on Debian). First
 //   touch of the large arrays costs 512x fewer page faults: level 11 setup
 //   1.7 -> 0.7 s, the whole run 13.6 -> 9.9 s (perf/RESULTS.md §0d).
 void default_runtime_environment(char** argv);
+// how idle OpenMP threads wait in this process: "OMP_WAIT_POLICY=...,
+// GOMP_SPINCOUNT=..." as the runtime read them (printed and in the JSON)
+std::string omp_wait_setting();
 // Exits with status 2 and a message (from the first rank) when mpirun
 // started this program as several ranks: for the drivers that are not
 // distributed (scaling, mg_scaling, roofline), whose N copies would each

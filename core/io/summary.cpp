@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "core/io/cli.hpp"
 #include "core/io/output.hpp"
 #include "core/io/problem_file.hpp"
 #include "kernels/simd.hpp"
@@ -69,6 +70,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                                 {"collectives", c.collectives}};
   }
   j["build"] = build_info();
+  j["omp_wait"] = omp_wait_setting();
   j["mg_precision"] = to_string(opt.mg.precision);
   j["newton_iterations"] = N.iterations;
   j["converged"] = R.converged();
