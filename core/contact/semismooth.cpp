@@ -133,7 +133,7 @@ void add_coupling(const ReducedSystem& L, index p, const real* Sx, real* y) {
 // y = mask_F (S x + H x (+ F t (S x)_z: Coulomb Newton)), with the side
 // product [S x | E x] (3p + S.full_size()): the CG accumulates both along its
 // iterate, so after the step it holds the running S Δu_F, whose norm sets the
-// accuracy of the bookkeeping apply of S Δu, and E Δu_F, that apply's initial
+// accuracy of the update's apply of S Δu, and E Δu_F, that apply's initial
 // guess. The inner tolerance is this step's own state, relaxed as its outer
 // CG converges.
 class ReducedNewtonOperator : public LinearOperatorWithSide {
@@ -232,7 +232,7 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
     // is fixed at 0.3 eta (0.1: 2-9 % more work, 1: a fifth Newton step at
     // level 10, F = 0.8); relaxing it as the residual falls, as for CG, cost
     // 1-2 more Newton steps (perf/RESULTS.md). S Δu is not a side product
-    // here (the caller's bookkeeping apply sets its accuracy from |Δu|)
+    // here (the update's apply of S Δu bounds it by smax |Δu|)
     GMRESOptions go;
     go.atol = target;
     go.rtol = 1e-13;

@@ -57,7 +57,7 @@ CommVolume allreduce_volume(double n, int ranks);
 // the contact vectors distributed like the grid: `outer` boundary Krylov
 // iterations, each an S apply (an inner MG-CG solve of `inner`
 // iterations and two plane applies), a K + B V-cycle and 2 allreduces;
-// plus two more S applies (the known increments and the bookkeeping S du),
+// plus two more S applies (the known increments and the update's S du),
 // 10 scalar allreduces (norms, counts, the known-increment flag) and the
 // allreduce of the K + B block over the bottom plane (4 nx ny doubles)
 CommVolume newton_step_comm(const std::vector<GridDims>& grids, int px, int py, int degree, double outer, double inner);
