@@ -131,7 +131,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   // solve of its own (a coarser mesh of nested iteration always, to hand up
   // its K_ii^{-1} l_i)
   SolveStats cond;
-  if (newton.u0 || opt.keep_interior_load) {
+  const bool loose_load = newton.u0 || opt.keep_interior_load;
+  if (loose_load) {
     std::vector<real> btilde;
     cond = S.condensed_load(opt.scale_rtol, btilde, opt.keep_interior_load ? &R.interior_load : nullptr,
                             load_guess.empty() ? nullptr : load_guess.data());
@@ -139,7 +140,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   }
   load_guess = {};
   const double t2 = wall_time();
-  if (opt.phase_done && newton.force_scale > 0) opt.phase_done("|b~| (loose condensed load)", t2 - t1);
+  if (opt.phase_done && loose_load) opt.phase_done("|b~| (loose condensed load)", t2 - t1);
   if (!cond.ok()) {
     // b̃ is untrustworthy: report instead of iterating on a wrong problem
     const index p = S.contact_nodes();

@@ -35,15 +35,15 @@ struct InnerWork {
   // one application of S at inner tolerance rtol, counted; false if the inner solve failed
   bool apply(const SteklovPoincare& S, const real* v, real* Sv, real rtol, real* extension = nullptr,
              const real* guess = nullptr) {
-    const SolveStats st = S.apply(v, Sv, rtol, extension, guess);
-    iterations += st.iterations;
-    failures += st.ok() ? 0 : 1;
-    fine_matvecs += S.apply_work(st.iterations);
-    return st.ok();
+    return count(S, S.apply(v, Sv, rtol, extension, guess));
   }
   // r = S u - b̃ (SteklovPoincare::residual), counted the same way
   bool residual(const SteklovPoincare& S, const real* u, real* r, real rtol, real* body, const real* guess) {
-    const SolveStats st = S.residual(u, r, rtol, body, guess);
+    return count(S, S.residual(u, r, rtol, body, guess));
+  }
+
+ private:
+  bool count(const SteklovPoincare& S, const SolveStats& st) {
     iterations += st.iterations;
     failures += st.ok() ? 0 : 1;
     fine_matvecs += S.apply_work(st.iterations);
@@ -143,9 +143,16 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
   index size() const override { return S_.size(); }
   index side_size() const override { return S_.size() + S_.full_size(); }
   void set_inner_rtol(real r) { rtol_ = r; }
-  void apply(const real* x, real* y, real* side) const override {
-    real* Sx = side;
-    work_.apply(S_, x, Sx, rtol_, side + S_.size());
+  void apply(const real* x, real* y, real* side) const override { apply(x, y, side, side + S_.size()); }
+  void apply(const real* x, real* y) const override {
+    std::vector<real> Sx(S_.size());  // (GMRES: no side product, so no 3D extension either)
+    apply(x, y, Sx.data(), nullptr);
+  }
+
+ private:
+  // y as above and Sx = S x; E x into `extension` if not null
+  void apply(const real* x, real* y, real* Sx, real* extension) const {
+    work_.apply(S_, x, Sx, rtol_, extension);
     const index p = S_.size() / 3;
     const real* h = L_.h.data();
     for (index i = 0; i < p; ++i) {
@@ -157,12 +164,7 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
     for (index i = 0; i < 3 * p; ++i)
       if (!L_.free[i]) y[i] = 0;
   }
-  void apply(const real* x, real* y) const override {
-    std::vector<real> side(side_size());  // the Newton step always asks for S x too
-    apply(x, y, side.data());
-  }
 
- private:
   const SteklovPoincare& S_;
   const ReducedSystem& L_;
   InnerWork& work_;
@@ -307,7 +309,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
   // the approximation step's metric (contact_maps.hpp): the paper's (s = 1) or
   // s_i = mean diagonal of K_cc at contact node i; kept in the result for
   // the final report's status
-  if (opt.scaling == StepScaling::diagonal) R.scale = step_scale(S);
+  const std::vector<real> diagonal_scale = step_scale(S);
+  if (opt.scaling == StepScaling::diagonal) R.scale = diagonal_scale;
   const std::vector<real>& scale = R.scale;
   auto finish = [&](NewtonReason reason) {
     R.reason = reason;
@@ -354,7 +357,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
   // its largest diagonal entry (Gershgorin: the off-diagonal row sums of the
   // Q1 elasticity stencil are 2-3 times the diagonal)
   real smax = 0;
-  for (real sc : (scale.empty() ? step_scale(S) : scale)) smax = std::max(smax, sc);
+  for (real sc : diagonal_scale) smax = std::max(smax, sc);
   smax = 4 * S.max(smax);
 
   bool last_step_hit_limit = false;
