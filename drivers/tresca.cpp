@@ -270,9 +270,9 @@ int main(int argc, char** argv) {
       };
     if (!quiet)
       opt.newton.progress = [](const NewtonProgress& p) {
-        std::printf("  it %2d  |v| %10.3e  contact %7lld  separated %7lld  stick %7lld  slip %7lld  inner %7lld  outer %5lld  %8.2f s\n",
-                    p.iteration, p.residual, (long long)p.active, (long long)p.separated, (long long)p.sticking,
-                    (long long)p.sliding, p.inner_iterations, p.outer_iterations, p.elapsed);
+        std::printf("  it %2d  |v| %10.3e  step %5.3f  contact %7lld  separated %7lld  stick %7lld  slip %7lld  inner %7lld  outer %5lld  %8.2f s\n",
+                    p.iteration, p.residual, p.step_length, (long long)p.active, (long long)p.separated,
+                    (long long)p.sticking, (long long)p.sliding, p.inner_iterations, p.outer_iterations, p.elapsed);
         std::fflush(stdout);
       };
     if (!table.empty()) {
@@ -383,9 +383,9 @@ int main(int argc, char** argv) {
     }
     if (R.metric_fallback)
       std::printf("Newton in the diagonal metric stagnated; the run was redone in the paper's metric from x0 = 0\n");
-    std::printf("%s after %d Newton iterations (reason: %s), final |v| %s (eps %.1e)\n",
-                N.converged() ? "converged" : "NOT CONVERGED", N.iterations, to_string(N.reason), last,
-                opt.newton.eps);
+    std::printf("%s after %d Newton iterations (reason: %s), final |v| %s %s(tolerance %.1e)\n",
+                R.converged() ? "converged" : "NOT CONVERGED", N.iterations, R.reason().c_str(), last,
+                N.stop == StopRule::consistent ? "N " : "(the paper's rule) ", N.tolerance);
     std::printf("true residual (fresh S u - b~): %.3e absolute, %.3e relative to |b| = %.3e\n", F.true_residual,
                 F.true_residual_relative, F.btilde_norm);
     if (N.reason == NewtonReason::stagnation && !N.history.empty() && N.history.back() <= 1e-9 * N.history.front())
@@ -403,6 +403,12 @@ int main(int argc, char** argv) {
     std::printf("KKT: equilibrium %.2e N, uz<0 %.2e m, lambda<0 %.2e N, lambda*uz %.2e Nm, |r_t|-phi %.2e N, direction %.2e N, stick slip %.2e m\n",
                 F.equilibrium, F.uz_violation, F.lambda_violation, F.complementarity, F.friction_bound,
                 F.friction_direction, F.stick_slip);
+    std::printf("KKT in consistent units: largest %.2e N, |w| %.2e N, tolerance %.2e N: %s", F.kkt_force,
+                F.true_residual_consistent, F.tolerance, F.kkt_ok ? "ok" : "FAILED");
+    if (F.slip_unresolved > 0)
+      std::printf(" (%lld sliding nodes slip less than the tolerance: direction not checked)",
+                  (long long)F.slip_unresolved);
+    std::printf("\n");
     std::printf("contact: %lld active, %lld separated, %lld sticking, %lld sliding; min ux %.6e, max uz %.6e, sum lambda %.6e\n",
                 (long long)F.active, (long long)F.separated, (long long)F.sticking, (long long)F.sliding, F.ux_min,
                 F.uz_max, F.lambda_sum);

@@ -12,18 +12,31 @@ namespace {
 // d_12, d_4 of the approximation step at scale s (contact_maps.hpp)
 struct NodeStep {
   real d1, d2, d4;
-  bool stick;
+  bool stick, contact;
 };
 inline NodeStep node_step(real s, real phi, real x1, real x2, real x3, real x4, real r1, real r2) {
   const real z1 = x1 - r1 / s, z2 = x2 - r2 / s;
   const real nz = std::sqrt(z1 * z1 + z2 * z2);
   const real t = s * nz > phi ? 1 - phi / (s * nz) : 0;
-  return {t * z1, t * z2, std::max(real(0), x4 - s * x3), t == 0};
+  // contact where lambda - s (u_z + g) >= 0: a node on the kink (lambda = 0
+  // on the obstacle, e.g. every node of a cold start) is taken in contact
+  const real c = x4 - s * x3;
+  return {t * z1, t * z2, std::max(real(0), c), t == 0, c >= 0};
 }
 }  // namespace
 
-real approximation_step(index p, const ContactLaw& law, const real* scale, const real* u, const real* lambda,
-                        const real* r, real* v, real* d, std::uint8_t* status) {
+StateCounts count_states(index p, const std::uint8_t* status) {
+  StateCounts c;
+  for (index i = 0; i < p; ++i) switch (contact_state(status[i])) {
+      case ContactState::separated: c.separated += 1; break;
+      case ContactState::stick: c.stick += 1; break;
+      case ContactState::slip: c.slip += 1; break;
+    }
+  return c;
+}
+
+ResidualNorms approximation_step(index p, const ContactLaw& law, const real* scale, const real* units, const real* u,
+                                 const real* lambda, const real* r, real* v, real* w, real* d, std::uint8_t* status) {
   TRESCA_ASSERT(p >= 0 && (p == 0 || (law.phi != nullptr && law.gap != nullptr)));
   // per-node work in parallel, then the deterministic blocked sum of v.v.
   // (The test oracle is the dense reference Newton in tests/test_newton.cpp.)
@@ -37,13 +50,20 @@ real approximation_step(index p, const ContactLaw& law, const real* scale, const
     v[p + i] = paper.d2 - x2;
     v[2 * p + i] = -(r[2 * p + i] - x4);
     v[3 * p + i] = paper.d4 - x4;
-    const NodeStep step = scale ? node_step(scale[i], law.phi[i], x1, x2, x3, x4, r1, r2) : paper;
+    const NodeStep unit = units ? node_step(units[i], law.phi[i], x1, x2, x3, x4, r1, r2) : paper;
+    const real su = units ? units[i] : 1;
+    w[i] = su * (unit.d1 - x1);
+    w[p + i] = su * (unit.d2 - x2);
+    w[2 * p + i] = v[2 * p + i];
+    w[3 * p + i] = unit.d4 - x4;
+    const NodeStep step = scale ? (scale == units ? unit : node_step(scale[i], law.phi[i], x1, x2, x3, x4, r1, r2))
+                                : paper;
     d[i] = step.d1;
     d[p + i] = step.d2;
     d[2 * p + i] = step.d4;
-    status[i] = std::uint8_t((step.d4 > 0 ? kContact : 0) | (step.stick ? kStick : 0));
+    status[i] = std::uint8_t((step.contact ? kContact : 0) | (step.stick ? kStick : 0));
   }
-  return dot(4 * p, v, v);
+  return {dot(4 * p, v, v), dot(4 * p, w, w)};
 }
 
 }  // namespace tresca

@@ -14,7 +14,16 @@
 // forces of 1e7 N a force residual of 1 N outweighs any displacement. With
 // s = diag(S) the comparison is in consistent units (issue 9, item 4). Both
 // have the same fixed points: d = x iff x solves the problem.
-// Node status: sticking iff d_12 = 0; in contact iff d_4 > 0.
+// Node status: sticking iff d_12 = 0; in contact iff d_4 > 0. A node's
+// state for every output is one of separated / stick / slip
+// (contact_state: separation first; a separated node's friction bit still
+// matters to Tresca's law, whose bound does not depend on contact).
+//
+// Residual in consistent units [N] (the stopping rule and the line search's
+// merit, method.md §5): the step at the units' stiffness s_i with its
+// displacement parts turned into forces,
+//   w = (s v_12, v_3, v_4)  at scale s,  |w| = 0 iff x solves the problem;
+// the paper's |v̂| (s = 1) adds metres to newtons.
 // Newton blocks (10): sliding H_1 = phi/|d|^3 [[d2², −d1 d2], [−d1 d2, d1²]].
 //
 // DATA LAYOUT: SoA. u, r: [x | y | z] blocks of p; lambda, phi, gap, scale: p;
@@ -29,7 +38,7 @@ namespace tresca {
 
 enum : std::uint8_t { kContact = 1, kStick = 2 };
 
-constexpr Cost kApproximationStepCost{144, 52};  // per contact node, scaled step and paper's v̂
+constexpr Cost kApproximationStepCost{177, 78};  // per contact node: reads u, lambda, r, phi, gap, s, units; writes v, w, d, status
 
 // The contact law of p nodes: Tresca bounds phi (N) and gaps (m), p values each.
 struct ContactLaw {
@@ -37,11 +46,31 @@ struct ContactLaw {
   const real* gap;
 };
 
-// v: the paper's v̂ (s = 1), whose norm is the stopping rule (11) whatever
-// the scaling; d and status: the step at scale s (nullptr: s = 1, and then
-// d_12 = x_12 + v_12, d_4 = lambda + v_4). Returns |v̂|^2 (deterministic order).
-real approximation_step(index p, const ContactLaw& law, const real* scale, const real* u, const real* lambda,
-                        const real* r, real* v, real* d, std::uint8_t* status);
+enum class ContactState : std::uint8_t { separated, stick, slip };
+inline ContactState contact_state(std::uint8_t status) {
+  return !(status & kContact) ? ContactState::separated : (status & kStick) ? ContactState::stick : ContactState::slip;
+}
+inline const char* to_string(ContactState s) {
+  return s == ContactState::separated ? "separated" : s == ContactState::stick ? "stick" : "slip";
+}
+// the three states' counts over p statuses (contact = stick + slip)
+struct StateCounts {
+  index separated = 0, stick = 0, slip = 0;
+  index contact() const { return stick + slip; }
+};
+StateCounts count_states(index p, const std::uint8_t* status);
+
+// |v̂|^2 of the paper's step (s = 1, its rule (11)) and |w|^2 of the
+// residual in consistent units [N^2] (deterministic order)
+struct ResidualNorms {
+  real paper = 0, consistent = 0;
+};
+
+// v: the paper's v̂ (s = 1); w: the residual in consistent units at the
+// stiffness `units` (nullptr: w = v̂); d and status: the step at scale s
+// (nullptr: s = 1, and then d_12 = x_12 + v_12, d_4 = lambda + v_4).
+ResidualNorms approximation_step(index p, const ContactLaw& law, const real* scale, const real* units, const real* u,
+                                 const real* lambda, const real* r, real* v, real* w, real* d, std::uint8_t* status);
 
 // The 2x2 block H_1 of a sliding node from d_12 (entries h11, h12, h22).
 inline void sliding_block(real phi, real d1, real d2, real& h11, real& h12, real& h22) {

@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
     Multigrid mg(g, P.interior_faces, P.spec.E, P.spec.nu);
     // the approximation step on as many nodes as the grid has (a streaming
     // size; the benchmark's own contact face is small enough to sit in cache)
-    std::vector<real> lam(N, 1.0), phi(N, 1.0), gap(N, 0.0), scale(N, 2e8), v(4 * N), d(3 * N);
+    std::vector<real> lam(N, 1.0), phi(N, 1.0), gap(N, 0.0), scale(N, 2e8), v(4 * N), w4(4 * N), d(3 * N);
     std::vector<std::uint8_t> status(N);
 
     const int R = int(reps);
@@ -168,7 +168,7 @@ int main(int argc, char** argv) {
     add("cheb_update", dofs, dofs * kChebUpdateCost,
         [&] { cheb_update(n, 0.5, 1e-9, b.data(), x.data(), w.data(), z.data()); });
     add("approximation step", nodes, nodes * kApproximationStepCost, [&] {
-      approximation_step(N, ContactLaw{phi.data(), gap.data()}, scale.data(), x.data(), lam.data(), b.data(), v.data(), d.data(), status.data());
+      approximation_step(N, ContactLaw{phi.data(), gap.data()}, scale.data(), scale.data(), x.data(), lam.data(), b.data(), v.data(), w4.data(), d.data(), status.data());
     });
     add("V-cycle (single)", dofs, Cost{}, [&] { mg.apply(b.data(), y.data()); });
     MGOptions md;

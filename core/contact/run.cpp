@@ -183,7 +183,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   // Newton did not run, the guess at u0), also recovers the body
   if (!R.newton.body.empty()) body = std::move(R.newton.body);
   R.newton.body = {};
-  R.report = final_report(S, law, R.newton, opt.tight_rtol, &body);
+  R.report = final_report(S, law, R.newton, opt.tight_rtol, &body,
+                          std::max(R.newton.tolerance, opt.kkt_rtol * R.newton.force_scale));
   if (S.distributed()) {
     // the run's results for every contact node on every rank (outputs, the
     // next finer mesh of nested iteration)

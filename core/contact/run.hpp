@@ -61,6 +61,9 @@ struct RunOptions {
   // less work at levels 7-12, fine Newton steps unchanged; perf/RESULTS.md)
   real nested_rtol = 1e-3;
   real tight_rtol = 1e-12;
+  // the final check's verdict: KKT in consistent units within
+  // max(Newton's tolerance, kkt_rtol |b̃|) (100 times what the check resolves)
+  real kkt_rtol = 1e-10;
   // |b̃| (the scale of the absolute accuracies) of a run with an initial
   // iterate, by a solve to this relative accuracy
   real scale_rtol = 1e-3;
@@ -109,9 +112,13 @@ struct RunResult {
   // steps took over from x0 = 0 (its work and time included)
   bool metric_fallback = false;
   real coulomb_consistency = 0;  // max_i |phi_i - F lambda_i| at the solution [N]
-  bool converged() const { return newton.converged() && (!coulomb || coulomb_loop.converged()); }
+  // converged: Newton's test, the Coulomb fixed point's, and the final
+  // check's KKT verdict (report.hpp) all say so
+  bool converged() const { return newton.converged() && (!coulomb || coulomb_loop.converged()) && report.kkt_ok; }
   std::string reason() const {
-    return !newton.converged() || !coulomb ? to_string(newton.reason) : to_string(coulomb_loop.reason);
+    if (!newton.converged()) return to_string(newton.reason);
+    if (coulomb && !coulomb_loop.converged()) return to_string(coulomb_loop.reason);
+    return report.kkt_ok ? "converged" : "kkt_check_failed";
   }
   FinalReport report;
   std::vector<real> u_full;         // 3N SoA (empty if not recovered); several ranks: slab's local vector

@@ -266,14 +266,6 @@ std::vector<real> step_scale(const SteklovPoincare& S) {
   return s;
 }
 
-bool stagnated(const std::vector<real>& h, int w) {
-  const int k = int(h.size());
-  if (k < 2 * w) return false;
-  const real last = *std::max_element(h.end() - w, h.end());
-  const real before = *std::max_element(h.end() - 2 * w, h.end() - w);
-  return last > 0.5 * before;
-}
-
 NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt) {
   // Coulomb (opt.coulomb >= 0): the bound follows lambda at every iteration
   ContactConditions law = given;
@@ -309,7 +301,9 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
   // the approximation step's metric (contact_maps.hpp): the paper's (s = 1) or
   // s_i = mean diagonal of K_cc at contact node i; kept in the result for
   // the final report's status
-  const std::vector<real> diagonal_scale = step_scale(S);
+  R.units = step_scale(S);
+  R.stop = opt.stop;
+  const std::vector<real>& diagonal_scale = R.units;
   if (opt.scaling == StepScaling::diagonal) R.scale = diagonal_scale;
   const std::vector<real>& scale = R.scale;
   auto finish = [&](NewtonReason reason) {
@@ -344,15 +338,32 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
   const real fscale = R.force_scale;
   real r_err = (opt.r0 ? opt.residual_accuracy : opt.initial_residual_rtol) * fscale;
 
+  const real* scale_ptr = scale.empty() ? nullptr : scale.data();
+  // a trial point of the line search and the approximation step's scratch
+  struct Trial {
+    std::vector<real> u, lambda, r, v, w, d;
+    std::vector<std::uint8_t> status;
+  } trial{std::vector<real>(n3), std::vector<real>(p), std::vector<real>(n3), std::vector<real>(4 * p),
+          std::vector<real>(4 * p), std::vector<real>(3 * p), std::vector<std::uint8_t>(p)};
   // side: [S Δu | E Δu] of the step; known_side: the same of its known increments
-  std::vector<real> v(4 * p), d(3 * p), du(n3), side(n3 + nf), known_side(n3 + nf);
-  std::vector<real> v_at_d(opt.coulomb_newton ? 4 * p : 0);  // (Coulomb Newton: the second step's v̂, not used)
+  std::vector<real> v(4 * p), d(3 * p), du(n3), side(n3 + nf), known_side(n3 + nf), dlambda(p);
+  // the residual in consistent units is measured in the stiffness of the
+  // diagonal metric whatever the step's metric
+  const real* units = diagonal_scale.data();
+  // the approximation step at (u, lambda, r) with the law's bound (Coulomb:
+  // phi_i = F lambda_i of that iterate): v̂, d and status into the given arrays
+  auto residual_at = [&](const std::vector<real>& u, const std::vector<real>& lambda, const std::vector<real>& r,
+                         std::vector<real>& vv, std::vector<real>& dd, std::vector<std::uint8_t>& st) {
+    if (opt.coulomb >= 0)
+      for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * std::max(real(0), lambda[i]);
+    return approximation_step(p, law.law(), scale_ptr, units, u.data(), lambda.data(), r.data(), vv.data(),
+                              trial.w.data(), dd.data(), st.data());
+  };
   ReducedSystem L(n3);
   std::unique_ptr<BoundaryPreconditioner> M;
   if (opt.outer_pc == OuterPreconditioner::multigrid)
     M = std::make_unique<BoundaryPreconditioner>(S, S.mg_options());
   CGWorkspace ws;
-  const real* scale_ptr = scale.empty() ? nullptr : scale.data();
   // |S x| <= smax |x|: S <= K_cc, whose largest eigenvalue is below 4 times
   // its largest diagonal entry (Gershgorin: the off-diagonal row sums of the
   // Q1 elasticity stencil are 2-3 times the diagonal)
@@ -366,20 +377,19 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
     // 1. approximation step at x = (u, lambda), r = S u - b̃, and the step's
     // forcing term; r is refreshed first if it is not accurate enough for
     // them (Tolerances)
-    real vnorm, eta_k, tol;
+    real vnorm, merit, eta_k, tol;
     for (int pass = 0;; ++pass) {
       {
         ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
-        if (opt.coulomb >= 0)
-          for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * std::max(real(0), R.lambda[i]);
-        vnorm = std::sqrt(S.sum(approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), R.r.data(),
-                                                   v.data(), d.data(), R.status.data())));
+        const ResidualNorms norms = residual_at(R.u, R.lambda, R.r, v, d, R.status);
+        merit = std::sqrt(S.sum(norms.consistent));
+        vnorm = opt.stop == StopRule::consistent ? merit : std::sqrt(S.sum(norms.paper));
         if (opt.coulomb >= 0 && opt.coulomb_newton) {
           // the step's point on the Coulomb graph: its pressure d_4 sets the
           // bound of its friction force (v̂, the residual, stays at lambda)
           for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * d[2 * p + i];
-          approximation_step(p, law.law(), scale_ptr, R.u.data(), R.lambda.data(), R.r.data(), v_at_d.data(),
-                             d.data(), R.status.data());
+          approximation_step(p, law.law(), scale_ptr, units, R.u.data(), R.lambda.data(), R.r.data(),
+                             trial.v.data(), trial.w.data(), d.data(), R.status.data());
         }
       }
       tol = std::max(opt.eps, opt.rtol * (k == 0 ? vnorm : R.history[0]));
@@ -409,26 +419,25 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
       r_err = need;
     }
     eta = eta_k;
+    R.tolerance = tol;
     R.history.push_back(vnorm);
+    R.merit.push_back(merit);
     R.inner_history.push_back(work.iterations);
     R.outer_history.push_back(R.outer_iterations);
     if (opt.progress) {
+      const StateCounts c = count_states(p, R.status.data());
       NewtonProgress pr{k, vnorm, 0, 0, 0, 0, work.iterations, R.outer_iterations, wall_time() - t0,
                         &R.u, &R.lambda, &R.r, &R.status, &law.phi};
-      for (index i = 0; i < p; ++i) {
-        (R.status[i] & kContact ? pr.active : pr.separated) += 1;
-        (R.status[i] & kStick ? pr.sticking : pr.sliding) += 1;
-      }
-      pr.active = index(S.sum(real(pr.active)));  // counts over all ranks
-      pr.separated = index(S.sum(real(pr.separated)));
-      pr.sticking = index(S.sum(real(pr.sticking)));
-      pr.sliding = index(S.sum(real(pr.sliding)));
+      pr.separated = index(S.sum(real(c.separated)));  // counts over all ranks
+      pr.sticking = index(S.sum(real(c.stick)));
+      pr.sliding = index(S.sum(real(c.slip)));
+      pr.active = pr.sticking + pr.sliding;
+      pr.step_length = R.step_lengths.empty() ? 1 : R.step_lengths.back();
       opt.progress(pr);
     }
     if (!std::isfinite(vnorm)) return finish(NewtonReason::non_finite);
     if (vnorm <= tol) return finish(NewtonReason::converged);
     if (k >= opt.max_iterations) return finish(NewtonReason::iteration_limit);
-    if (stagnated(R.history, opt.stagnation_window)) return finish(NewtonReason::stagnation);
 
     // 2. linearisation: known increments, free set, H, right-hand side
     // (any rank's known increments make every rank apply S to them: S is collective)
@@ -468,11 +477,34 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
     R.operator_applications += 1;
     if (!work.apply(S, du.data(), Sdu, inc_rtol, Edu, Edu)) return finish(NewtonReason::inner_failure);
     r_err = std::max(r_err, accuracy);
-    for (index i = 0; i < p; ++i)
-      R.lambda[i] += L.dlambda[i] + ((R.status[i] & kContact) ? Sdu[2 * p + i] : 0);
-    axpy(n3, 1, du.data(), R.u.data());
-    axpy(n3, 1, Sdu, R.r.data());
-    axpy(nf, 1, Edu, R.body.data());
+    for (index i = 0; i < p; ++i) dlambda[i] = L.dlambda[i] + ((R.status[i] & kContact) ? Sdu[2 * p + i] : 0);
+
+    // 5. the step's length: the non-monotone line search on the merit |w|
+    // (NewtonOptions::line_search); r, lambda and u are linear along it
+    real alpha = 1;
+    if (opt.line_search) {
+      const int m = std::min<int>(opt.line_search_memory + 1, int(R.merit.size()));
+      const real reference = *std::max_element(R.merit.end() - m, R.merit.end());
+      bool accepted = false;
+      for (int j = 0; j <= opt.line_search_halvings && !accepted; ++j) {
+        for (index i = 0; i < n3; ++i) {
+          trial.u[i] = R.u[i] + alpha * du[i];
+          trial.r[i] = R.r[i] + alpha * Sdu[i];
+        }
+        for (index i = 0; i < p; ++i) trial.lambda[i] = R.lambda[i] + alpha * dlambda[i];
+        ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
+        const real m_trial =
+            std::sqrt(S.sum(residual_at(trial.u, trial.lambda, trial.r, trial.v, trial.d, trial.status).consistent));
+        accepted = m_trial <= (1 - 1e-4 * alpha) * reference;
+        if (!accepted) alpha *= 0.5;
+      }
+      if (!accepted) return finish(NewtonReason::stagnation);
+    }
+    R.step_lengths.push_back(alpha);
+    axpy(p, alpha, dlambda.data(), R.lambda.data());
+    axpy(n3, alpha, du.data(), R.u.data());
+    axpy(n3, alpha, Sdu, R.r.data());
+    axpy(nf, alpha, Edu, R.body.data());
     R.iterations = k + 1;
   }
 }

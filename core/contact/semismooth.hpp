@@ -55,7 +55,7 @@ const char* to_string(NewtonReason r);
 
 struct NewtonProgress {
   int iteration;
-  real residual;  // ||v̂|| of this approximation step
+  real residual;  // the stopping quantity of this approximation step (NewtonOptions::stop)
   index active, separated, sticking, sliding;
   long long inner_iterations, outer_iterations;  // cumulative
   double elapsed;
@@ -66,6 +66,7 @@ struct NewtonProgress {
   const std::vector<real>* r = nullptr;
   const std::vector<std::uint8_t>* status = nullptr;
   const std::vector<real>* phi = nullptr;
+  real step_length = 1;  // alpha of the step that led here (1: full; the first iterate: 1)
 };
 
 enum class OuterPreconditioner { multigrid, none };
@@ -75,9 +76,17 @@ enum class OuterPreconditioner { multigrid, none };
 // from the diagonal of K_cc (consistent units; issue 9, item 4).
 enum class StepScaling { paper, diagonal };
 
+// The stopping quantity: the residual in consistent units |w| [N]
+// (contact_maps.hpp: displacement parts times the node's stiffness s_i),
+// or the paper's |v̂| of its rule (11), which adds metres to newtons (with
+// E = 7e10 and phi = 5e6 it stopped at 4e-7 while a slip direction was
+// 1e4 N off); the paper's for --table only.
+enum class StopRule { consistent, paper };
+
 struct NewtonOptions {
-  real eps = 1e-6;
-  real rtol = 0;  // stop at ||v̂|| <= max(eps, rtol ||v̂_0||) (0: the paper's absolute rule)
+  real eps = 1e-6;  // [N]
+  real rtol = 0;    // stop at |w| <= max(eps, rtol |w_0|) (0: absolute)
+  StopRule stop = StopRule::consistent;
   // preconditioner of the reduced boundary system: one V-cycle of K + B
   // (boundary_preconditioner.hpp), or none (plain CG, for comparison)
   OuterPreconditioner outer_pc = OuterPreconditioner::multigrid;
@@ -90,16 +99,28 @@ struct NewtonOptions {
   real residual_accuracy = 1e-12;
   real residual_fraction = 0.1;
   real initial_residual_rtol = 1e-4;
-  // stop when the largest ||v̂|| of the last `stagnation_window` steps is not
-  // below half the largest of the window before (a lucky dip does not count)
-  int stagnation_window = 4;
+  // Globalisation: a non-monotone backtracking line search on the merit |w|
+  // (Grippo–Lampariello–Lucidi): a step of length alpha in 1, 1/2, ... is
+  // taken once |w(x + alpha Δ)| <= (1 - 1e-4 alpha) max of the last
+  // line_search_memory + 1 merits, so a step may rise above the last value
+  // (semismooth Newton wanders while the active set settles) but the
+  // window's maximum falls. Trial points cost no solve: r, lambda and the
+  // body are linear along the step, whose S Δu the update computes anyway.
+  // Stagnation: no length down to 2^-line_search_halvings decreases the
+  // merit (evidence that Newton is not converging, e.g. at the round-off
+  // floor of an unattainable eps). Off: full steps, and no stagnation test.
+  bool line_search = true;
+  int line_search_memory = 5;
+  int line_search_halvings = 10;
   std::function<void(const NewtonProgress&)> progress;
   // The paper's method: unscaled approximation step, whose decisions compare
   // forces with displacements, so its steps must be near-exact.
   static NewtonOptions paper_method() {
     NewtonOptions o;
     o.scaling = StepScaling::paper;
+    o.stop = StopRule::paper;
     o.forcing_max = 1e-10;
+    o.line_search = false;
     return o;
   }
   // optional initial iterate (default x0 = 0): u0 (3p) and lambda0 (p)
@@ -130,7 +151,10 @@ struct NewtonOptions {
 struct NewtonResult {
   NewtonReason reason = NewtonReason::iteration_limit;
   int iterations = 0;                  // Newton steps taken
-  std::vector<real> history;           // ||v̂|| after each approximation step (first at x0)
+  std::vector<real> history;           // the stopping quantity after each approximation step (first at x0)
+  std::vector<real> merit;             // |w| [N] there (the line search's merit; = history for StopRule::consistent)
+  std::vector<real> step_lengths;      // alpha of each step taken (1: a full Newton step)
+  real tolerance = 0;                  // the stopping test's max(eps, rtol |·_0|)
   std::vector<long long> inner_history, outer_history;  // cumulative inner / outer CG iterations there
   std::vector<real> u, lambda, r;      // 3p, p, 3p: r = S u - b̃ (to residual_accuracy if converged)
   std::vector<real> body;              // U = E u + K_ii^{-1} l_i (S.full_size()) of that r
@@ -138,6 +162,8 @@ struct NewtonResult {
   std::vector<std::uint8_t> status;    // per node: kContact | kStick at the last approximation step
   std::vector<real> phi;               // the Tresca bound of the last approximation step
   std::vector<real> scale;             // the steps' metric s_i (step_scale), empty: the paper's (s = 1)
+  std::vector<real> units;             // the stiffness s_i of the consistent units (step_scale) [N/m]
+  StopRule stop = StopRule::consistent;
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
   int outer_limit_hits = 0;  // Newton steps whose outer CG stopped at its iteration limit
   // work in fine-grid matvec equivalents, from the solvers' own counts and
@@ -145,13 +171,6 @@ struct NewtonResult {
   double fine_matvecs = 0;
   bool converged() const { return reason == NewtonReason::converged; }
 };
-
-// No progress over the history h of ||v̂||: the largest value of the last w
-// steps is not below half the largest of the w steps before. The method is not
-// monotone in ||v̂|| (a step may land near a solution with the wrong active
-// set and the next leave it), so progress is judged by window maxima, which an
-// isolated dip does not move; at the round-off floor the maxima stay flat.
-bool stagnated(const std::vector<real>& h, int w);
 
 // The contact law per contact node: Tresca bound phi_i >= 0 [N] and initial
 // gap g_i >= 0 [m] to the rigid obstacle (non-penetration u_z + g_i >= 0).

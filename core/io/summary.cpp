@@ -76,7 +76,10 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["converged"] = R.converged();
   j["fallback_to_paper_metric"] = R.metric_fallback;
   j["reason"] = R.reason();
+  j["stopping_rule"] = N.stop == StopRule::consistent ? "consistent" : "paper";
+  j["tolerance"] = N.tolerance;
   j["residual_history"] = N.history;
+  j["step_lengths"] = N.step_lengths;
   j["inner_iterations_history"] = N.inner_history;
   j["outer_iterations_history"] = N.outer_history;
   j["final_residual"] = N.history.empty() ? Json(nullptr) : Json(N.history.back());
@@ -99,7 +102,9 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["kkt"] = {{"equilibrium", F.equilibrium},         {"uz_violation", F.uz_violation},
               {"lambda_violation", F.lambda_violation}, {"complementarity", F.complementarity},
               {"friction_bound", F.friction_bound},   {"friction_direction", F.friction_direction},
-              {"stick_slip", F.stick_slip}};
+              {"stick_slip", F.stick_slip},           {"largest_in_newtons", F.kkt_force},
+              {"residual_consistent", F.true_residual_consistent}, {"tolerance", F.tolerance},
+              {"slip_unresolved", F.slip_unresolved}, {"ok", F.kkt_ok}};
   j["problem"] = Json::parse(problem_json(spec, R.coulomb ? opt.coulomb : -1));
   j["nested"] = nested;
   j["coulomb"] = coulomb;
