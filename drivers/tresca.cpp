@@ -381,8 +381,6 @@ int main(int argc, char** argv) {
                     R.coulomb_consistency);
       }
     }
-    if (R.metric_fallback)
-      std::printf("Newton in the diagonal metric stagnated; the run was redone in the paper's metric from x0 = 0\n");
     std::printf("%s after %d Newton iterations (reason: %s), final |v| %s %s(tolerance %.1e)\n",
                 R.converged() ? "converged" : "NOT CONVERGED", N.iterations, R.reason().c_str(), last,
                 N.stop == StopRule::consistent ? "N " : "(the paper's rule) ", N.tolerance);

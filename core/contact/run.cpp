@@ -219,39 +219,18 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.fine_matvecs_total = R.nested_fine_matvecs + R.newton_fine_matvecs() + S.apply_work(cond.iterations) +
                          S.apply_work(R.report.inner.iterations);
   R.peak_memory = Comm::world().max(peak_memory_bytes());  // several ranks: the largest rank's
-  // A failed Newton solve is redone another way, its work and time added
-  // to the new run's. Both ways have no line search:
-  // - one Coulomb Newton solve can oscillate for large F (lagged bound,
-  //   F = 1.5 on 32x16x16: stick and slip flip every step): the fixed point
-  //   of Tresca solves instead;
-  // - Tresca in the diagonal metric can cycle between two active sets where
-  //   the paper's metric converges (8x4x4 under pressure and shear with
-  //   phi_i = 2 |b̃_τ,i|: a 2-cycle against 4 steps): the paper's metric
-  //   with near-exact steps from x0 = 0 instead.
+  // A failed Coulomb Newton solve is redone as the fixed point of Tresca
+  // solves (each globalised by the line search), its work and time added to
+  // the new run's
   const bool coulomb_failed = R.coulomb && opt.coulomb_method != RunOptions::CoulombMethod::fixed_point &&
                               (R.newton.reason == NewtonReason::stagnation || R.newton.reason == NewtonReason::iteration_limit);
-  const bool metric_failed =
-      !R.coulomb && R.newton.reason == NewtonReason::stagnation && opt.newton.scaling == StepScaling::diagonal;
-  if (coulomb_failed || metric_failed) {
+  if (coulomb_failed) {
     RunOptions f = opt;
-    if (coulomb_failed) {
-      f.coulomb_method = RunOptions::CoulombMethod::fixed_point;
-    } else {
-      const NewtonOptions paper = NewtonOptions::paper_method();
-      f.newton.scaling = paper.scaling;
-      f.newton.forcing_max = paper.forcing_max;
-      f.newton.u0 = f.newton.lambda0 = nullptr;
-      f.newton.r0 = nullptr;
-      f.newton.body0 = nullptr;
-      f.newton.force_scale = 0;
-      f.nested = false;
-    }
+    f.coulomb_method = RunOptions::CoulombMethod::fixed_point;
     if (opt.phase_done)
-      opt.phase_done(coulomb_failed ? "Coulomb: one Newton solve did not converge; again by the fixed point"
-                                    : "Newton in the diagonal metric stagnated; again in the paper's",
-                     R.times.total);
+      opt.phase_done("Coulomb: one Newton solve did not converge; again by the fixed point", R.times.total);
     RunResult again = run_tresca(spec, f);
-    (coulomb_failed ? again.coulomb_fallback : again.metric_fallback) = true;
+    again.coulomb_fallback = true;
     again.fine_matvecs_total += R.fine_matvecs_total;
     again.times.total += R.times.total;
     return again;

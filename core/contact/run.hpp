@@ -107,10 +107,6 @@ struct RunResult {
   bool coulomb = false;
   CoulombResult coulomb_loop;
   bool coulomb_fallback = false;  // one Newton solve failed; the fixed point took over
-  // Tresca: Newton in the diagonal metric stagnated (it can cycle between
-  // two active sets from x0 = 0), and the paper's metric with near-exact
-  // steps took over from x0 = 0 (its work and time included)
-  bool metric_fallback = false;
   real coulomb_consistency = 0;  // max_i |phi_i - F lambda_i| at the solution [N]
   // converged: Newton's test, the Coulomb fixed point's, and the final
   // check's KKT verdict (report.hpp) all say so

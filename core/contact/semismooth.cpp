@@ -266,6 +266,14 @@ std::vector<real> step_scale(const SteklovPoincare& S) {
   return s;
 }
 
+bool stagnated(const std::vector<real>& h, int w) {
+  const int k = int(h.size());
+  if (w <= 0 || k <= w) return false;
+  const real before = *std::min_element(h.begin(), h.end() - w);
+  const real last = *std::min_element(h.end() - w, h.end());
+  return last > 0.5 * before;
+}
+
 NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt) {
   // Coulomb (opt.coulomb >= 0): the bound follows lambda at every iteration
   ContactConditions law = given;
@@ -438,6 +446,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
     if (!std::isfinite(vnorm)) return finish(NewtonReason::non_finite);
     if (vnorm <= tol) return finish(NewtonReason::converged);
     if (k >= opt.max_iterations) return finish(NewtonReason::iteration_limit);
+    if (stagnated(R.merit, opt.stagnation_window)) return finish(NewtonReason::stagnation);
 
     // 2. linearisation: known increments, free set, H, right-hand side
     // (any rank's known increments make every rank apply S to them: S is collective)

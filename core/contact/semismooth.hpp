@@ -106,12 +106,16 @@ struct NewtonOptions {
   // (semismooth Newton wanders while the active set settles) but the
   // window's maximum falls. Trial points cost no solve: r, lambda and the
   // body are linear along the step, whose S Δu the update computes anyway.
-  // Stagnation: no length down to 2^-line_search_halvings decreases the
-  // merit (evidence that Newton is not converging, e.g. at the round-off
-  // floor of an unattainable eps). Off: full steps, and no stagnation test.
+  // Stagnation, evidence that Newton is not converging: no length down to
+  // 2^-line_search_halvings decreases the merit, or the best merit of the
+  // last stagnation_window steps is not below half the best before them
+  // (the round-off floor of an unattainable eps, where the non-monotone
+  // search would let the iterates wander). Off: full steps, and only the
+  // second test.
   bool line_search = true;
   int line_search_memory = 5;
   int line_search_halvings = 10;
+  int stagnation_window = 10;
   std::function<void(const NewtonProgress&)> progress;
   // The paper's method: unscaled approximation step, whose decisions compare
   // forces with displacements, so its steps must be near-exact.
@@ -184,6 +188,9 @@ struct ContactConditions {
 // is smaller, but the iteration counts do not depend on a factor in 0.25..2
 // (perf/RESULTS.md), so the plain diagonal of K_cc it is
 std::vector<real> step_scale(const SteklovPoincare& S);
+
+// The window test above on the merit history h (window w)
+bool stagnated(const std::vector<real>& h, int w);
 
 NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& law, const NewtonOptions& opt);
 

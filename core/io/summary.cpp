@@ -74,7 +74,6 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["mg_precision"] = to_string(opt.mg.precision);
   j["newton_iterations"] = N.iterations;
   j["converged"] = R.converged();
-  j["fallback_to_paper_metric"] = R.metric_fallback;
   j["reason"] = R.reason();
   j["stopping_rule"] = N.stop == StopRule::consistent ? "consistent" : "paper";
   j["tolerance"] = N.tolerance;
