@@ -178,6 +178,11 @@ int main(int argc, char** argv) {
       const NewtonOptions paper = NewtonOptions::paper_method();
       opt.newton.scaling = paper.scaling;
       opt.newton.forcing_max = paper.forcing_max;
+      if (!table.empty()) {  // the paper's literal method: its stopping rule, full steps, its kink rule
+        opt.newton.stop = paper.stop;
+        opt.newton.line_search = paper.line_search;
+        opt.newton.kink_contact = paper.kink_contact;
+      }
     }
     const std::string prec = a.str("--mg-precision", "single");
     if (prec != "single" && prec != "double")
@@ -305,7 +310,7 @@ int main(int argc, char** argv) {
         if (pr) std::snprintf(pbuf, sizeof pbuf, "%9.3f %9.3f %9.3f %5d", pr->assembly, pr->schur, pr->solver, pr->iters);
         std::printf("%5d %9lld %9.3f %9.3f %7lld %9.3f %5d %5s | paper: %s | %.2e (%.1e)\n", L,
                     (long long)R.problem->nodes(), R.times.setup, R.times.condense, (long long)R.problem->contact_nodes(),
-                    R.times.solve, R.newton.iterations, R.newton.converged() ? "yes" : "NO", pbuf,
+                    R.times.solve, R.newton.iterations, R.converged() ? "yes" : "NO", pbuf,
                     R.report.true_residual, R.report.true_residual_relative);
         std::fflush(stdout);
         all = all && R.converged();

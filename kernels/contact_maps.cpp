@@ -14,14 +14,13 @@ struct NodeStep {
   real d1, d2, d4;
   bool stick, contact;
 };
-inline NodeStep node_step(real s, real phi, real x1, real x2, real x3, real x4, real r1, real r2) {
+inline NodeStep node_step(real s, real phi, real x1, real x2, real x3, real x4, real r1, real r2, bool kink_contact) {
   const real z1 = x1 - r1 / s, z2 = x2 - r2 / s;
   const real nz = std::sqrt(z1 * z1 + z2 * z2);
   const real t = s * nz > phi ? 1 - phi / (s * nz) : 0;
-  // contact where lambda - s (u_z + g) >= 0: a node on the kink (lambda = 0
-  // on the obstacle, e.g. every node of a cold start) is taken in contact
+  // contact where lambda - s (u_z + g) > 0, and on the kink (= 0) if asked
   const real c = x4 - s * x3;
-  return {t * z1, t * z2, std::max(real(0), c), t == 0, c >= 0};
+  return {t * z1, t * z2, std::max(real(0), c), t == 0, kink_contact ? c >= 0 : c > 0};
 }
 }  // namespace
 
@@ -45,18 +44,18 @@ ResidualNorms approximation_step(index p, const ContactLaw& law, const real* sca
     // x3 enters through F_4 = u_z + g
     const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + law.gap[i], x4 = lambda[i];
     const real r1 = r[i], r2 = r[p + i];
-    const NodeStep paper = node_step(1, law.phi[i], x1, x2, x3, x4, r1, r2);
+    const NodeStep paper = node_step(1, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact);
     v[i] = paper.d1 - x1;
     v[p + i] = paper.d2 - x2;
     v[2 * p + i] = -(r[2 * p + i] - x4);
     v[3 * p + i] = paper.d4 - x4;
-    const NodeStep unit = units ? node_step(units[i], law.phi[i], x1, x2, x3, x4, r1, r2) : paper;
+    const NodeStep unit = units ? node_step(units[i], law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact) : paper;
     const real su = units ? units[i] : 1;
     w[i] = su * (unit.d1 - x1);
     w[p + i] = su * (unit.d2 - x2);
     w[2 * p + i] = v[2 * p + i];
     w[3 * p + i] = unit.d4 - x4;
-    const NodeStep step = scale ? (scale == units ? unit : node_step(scale[i], law.phi[i], x1, x2, x3, x4, r1, r2))
+    const NodeStep step = scale ? (scale == units ? unit : node_step(scale[i], law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact))
                                 : paper;
     d[i] = step.d1;
     d[p + i] = step.d2;

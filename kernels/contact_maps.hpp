@@ -41,9 +41,15 @@ enum : std::uint8_t { kContact = 1, kStick = 2 };
 constexpr Cost kApproximationStepCost{177, 78};  // per contact node: reads u, lambda, r, phi, gap, s, units; writes v, w, d, status
 
 // The contact law of p nodes: Tresca bounds phi (N) and gaps (m), p values each.
+// kink_contact: a node on the kink lambda - s (u_z + g) = 0 (lambda = 0 on
+// the obstacle: every node of a cold start) is taken in contact, the
+// element of the generalised derivative whose step stays on the obstacle
+// (the line search's merit then falls along it); false: method.md's d_4 > 0,
+// the paper's literal method (--table).
 struct ContactLaw {
   const real* phi;
   const real* gap;
+  bool kink_contact = true;
 };
 
 enum class ContactState : std::uint8_t { separated, stick, slip };

@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "core/contact/run.hpp"
+#include "dense_reference.hpp"
 #include "test_helpers.hpp"
 
 namespace tresca {
@@ -139,6 +141,89 @@ TEST(Coulomb, ReportsAnIterationLimitOfTheFixedPoint) {
   co.F = -1;
   EXPECT_THROW(coulomb_fixed_point(S, ContactConditions::uniform(P.contact_nodes(), 0, 0), co, NewtonOptions{}),
                std::invalid_argument);
+}
+
+}  // namespace tresca
+
+namespace tresca {
+namespace {
+// The Coulomb problem's own conditions at (u, lambda), computed densely and
+// independently of the solver (dense Schur complement and condensed load,
+// dense_reference.hpp): r = S u - b̃, and per contact node
+//   r_z = lambda >= 0, u_z >= 0, lambda u_z = 0, |r_τ| <= F lambda,
+//   sticking (|r_τ| < F lambda): u_τ = 0; sliding: r_τ = -F lambda u_τ/|u_τ|.
+// Returns the counts of separated, sticking and sliding nodes.
+struct States {
+  index separated = 0, stick = 0, slip = 0;
+};
+// slack [N]: the fixed point's own stop (a relative change of phi of 1e-6)
+States expect_coulomb_kkt(const RunResult& R, real F, real rtol, real slack = 0) {
+  const DenseSchur D = dense_schur(*R.problem);
+  const index p = R.problem->contact_nodes();
+  Eigen::VectorXd u(3 * p);
+  for (index i = 0; i < 3 * p; ++i) u[i] = R.newton.u[i];
+  const Eigen::VectorXd r = D.S * u - D.b;
+  const real f = rtol * D.b.norm() + slack;  // [N]
+  const real umax = test::max_abs(R.newton.u), dl = rtol * umax;  // [m]
+  States st;
+  for (index i = 0; i < p; ++i) {
+    const real lam = R.newton.lambda[i], uz = u[2 * p + i];
+    const real rt = std::hypot(r[i], r[p + i]), ut = std::hypot(u[i], u[p + i]);
+    EXPECT_NEAR(r[2 * p + i], lam, f) << "node " << i;
+    EXPECT_GE(lam, -f) << "node " << i;
+    EXPECT_GE(uz, -dl) << "node " << i;
+    EXPECT_LE(std::min(std::abs(lam), std::abs(uz) * D.b.norm() / umax), f) << "node " << i;
+    EXPECT_LE(rt, F * std::max(real(0), lam) + f) << "node " << i;
+    if (lam <= f) {
+      st.separated += 1;
+    } else if (ut <= dl) {
+      st.stick += 1;
+    } else {
+      st.slip += 1;
+      // the direction of a slip ut is known to dl/ut
+      EXPECT_LE(std::hypot(r[i] + F * lam * u[i] / ut, r[p + i] + F * lam * u[p + i] / ut), f + F * lam * dl / ut)
+          << "node " << i;
+    }
+  }
+  return st;
+}
+}  // namespace
+
+// Issue 19: Coulomb at F = 2 stagnated (Newton wandered for five steps, and
+// the stagnation test stopped it just before it converged). Against the
+// Coulomb problem's conditions checked densely, on a mesh where nodes stick,
+// slide and separate, every method and F from 0.3 to 2 converge.
+TEST(Coulomb, HighFrictionConvergesToTheCoulombConditionsWithEveryMethod) {
+  const ProblemSpec spec = spec_for_dims(12, 6, 6);
+  for (real F : {0.3, 0.8, 1.2, 2.0}) {
+    const RunResult R = solve(spec, F, false, Method::newton);
+    ASSERT_TRUE(R.converged()) << "F = " << F << ": " << R.reason();
+    EXPECT_FALSE(R.coulomb_fallback) << "F = " << F;
+    EXPECT_TRUE(R.report.kkt_ok) << "F = " << F;
+    const States st = expect_coulomb_kkt(R, F, 1e-8);
+    std::printf("F = %.1f: %lld separated, %lld stick, %lld slip\n", F, (long long)st.separated, (long long)st.stick,
+                (long long)st.slip);
+    EXPECT_GT(st.slip, 0) << "F = " << F;
+    if (F >= 1.2) {  // all three states (at F = 0.3 and 0.8 nothing sticks on this mesh)
+      EXPECT_GT(st.separated, 0) << "F = " << F;
+      EXPECT_GT(st.stick, 0) << "F = " << F;
+    }
+    // one classification: the report's counts are the dense conditions'
+    EXPECT_EQ(R.report.separated, st.separated) << "F = " << F;
+    EXPECT_EQ(R.report.sticking, st.stick) << "F = " << F;
+    EXPECT_EQ(R.report.sliding, st.slip) << "F = " << F;
+  }
+  // the issue's meshes at F = 2, each method (lagged may hand over to the
+  // fixed point: it converges only linearly there)
+  for (const char* dims : {"9x7x5", "13x5x4"})
+    for (Method m : {Method::newton, Method::lagged, Method::fixed_point}) {
+      index ex, ey, ez;
+      ASSERT_EQ(std::sscanf(dims, "%lldx%lldx%lld", (long long*)&ex, (long long*)&ey, (long long*)&ez), 3);
+      const RunResult R = solve(spec_for_dims(ex, ey, ez), 2.0, true, m);
+      ASSERT_TRUE(R.converged()) << dims << " " << to_string(m) << ": " << R.reason();
+      const bool fixed_point = m == Method::fixed_point || R.coulomb_fallback;
+      expect_coulomb_kkt(R, 2.0, 1e-8, fixed_point ? 2e-6 * 2.0 * test::max_abs(R.newton.lambda) : 0);
+    }
 }
 
 }  // namespace tresca

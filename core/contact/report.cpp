@@ -25,7 +25,7 @@ FinalReport final_report(const SteklovPoincare& S, const ContactConditions& law,
   // the residual is the paper's |v̂| either way; the status (which nodes are
   // in contact, which stick) is decided in Newton's metric R.scale, so that
   // it does not depend on the units where a node is on the edge of two states
-  const ResidualNorms norms = approximation_step(p, law.law(), R.scale.empty() ? nullptr : R.scale.data(), units,
+  const ResidualNorms norms = approximation_step(p, law.law(R.kink_contact), R.scale.empty() ? nullptr : R.scale.data(), units,
                                                 R.u.data(), R.lambda.data(), F.r.data(), v.data(), w.data(), d.data(),
                                                 F.status.data());
   F.true_residual_consistent = std::sqrt(S.sum(norms.consistent));

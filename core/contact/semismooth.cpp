@@ -311,6 +311,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
   // the final report's status
   R.units = step_scale(S);
   R.stop = opt.stop;
+  R.kink_contact = opt.kink_contact;
   const std::vector<real>& diagonal_scale = R.units;
   if (opt.scaling == StepScaling::diagonal) R.scale = diagonal_scale;
   const std::vector<real>& scale = R.scale;
@@ -364,7 +365,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
                          std::vector<real>& vv, std::vector<real>& dd, std::vector<std::uint8_t>& st) {
     if (opt.coulomb >= 0)
       for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * std::max(real(0), lambda[i]);
-    return approximation_step(p, law.law(), scale_ptr, units, u.data(), lambda.data(), r.data(), vv.data(),
+    return approximation_step(p, law.law(opt.kink_contact), scale_ptr, units, u.data(), lambda.data(), r.data(), vv.data(),
                               trial.w.data(), dd.data(), st.data());
   };
   ReducedSystem L(n3);
@@ -396,7 +397,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
           // the step's point on the Coulomb graph: its pressure d_4 sets the
           // bound of its friction force (v̂, the residual, stays at lambda)
           for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * d[2 * p + i];
-          approximation_step(p, law.law(), scale_ptr, units, R.u.data(), R.lambda.data(), R.r.data(),
+          approximation_step(p, law.law(opt.kink_contact), scale_ptr, units, R.u.data(), R.lambda.data(), R.r.data(),
                              trial.v.data(), trial.w.data(), d.data(), R.status.data());
         }
       }

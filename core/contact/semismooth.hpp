@@ -113,6 +113,7 @@ struct NewtonOptions {
   // search would let the iterates wander). Off: full steps, and only the
   // second test.
   bool line_search = true;
+  bool kink_contact = true;  // contact_maps.hpp: ContactLaw::kink_contact
   int line_search_memory = 5;
   int line_search_halvings = 10;
   int stagnation_window = 10;
@@ -125,6 +126,7 @@ struct NewtonOptions {
     o.stop = StopRule::paper;
     o.forcing_max = 1e-10;
     o.line_search = false;
+    o.kink_contact = false;
     return o;
   }
   // optional initial iterate (default x0 = 0): u0 (3p) and lambda0 (p)
@@ -168,6 +170,7 @@ struct NewtonResult {
   std::vector<real> scale;             // the steps' metric s_i (step_scale), empty: the paper's (s = 1)
   std::vector<real> units;             // the stiffness s_i of the consistent units (step_scale) [N/m]
   StopRule stop = StopRule::consistent;
+  bool kink_contact = true;            // the options' kink rule (the status above)
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
   int outer_limit_hits = 0;  // Newton steps whose outer CG stopped at its iteration limit
   // work in fine-grid matvec equivalents, from the solvers' own counts and
@@ -181,7 +184,7 @@ struct NewtonResult {
 struct ContactConditions {
   std::vector<real> phi, gap;
   static ContactConditions uniform(index p, real phi, real gap) { return {std::vector<real>(p, phi), std::vector<real>(p, gap)}; }
-  ContactLaw law() const { return {phi.data(), gap.data()}; }
+  ContactLaw law(bool kink_contact = true) const { return {phi.data(), gap.data(), kink_contact}; }
 };
 
 // s_i = (K_xx + K_yy + K_zz)/3 at contact node i [N/m]: the diagonal of S
