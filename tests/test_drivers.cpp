@@ -359,3 +359,59 @@ TEST(TrescaDriver, TablePrintsPaperColumnsAndConverges) {
 }
 
 }  // namespace tresca
+
+namespace tresca {
+// Issue 19, item 3: one classification of contact states (separation first,
+// contact_state) in the console, the JSON, the CSV and the VTU, on a case
+// where nodes separate, stick and slide (the console and JSON used to count
+// separated nodes as sticking or sliding)
+TEST(TrescaDriver, EveryOutputCountsTheSameContactStates) {
+  const std::string dir = std::string(TRESCA_BIN_DIR) + "/../";
+  const std::string json = dir + "states.json", csv = dir + "states.csv", vtu = dir + "states.vtu";
+  const CmdResult r = run("tresca --dims 12x6x6 --phi 3e6 --json " + json + " --contact-csv " + csv + " --vtk " + vtu +
+                          " --vtk-format ascii");
+  ASSERT_EQ(r.status, 0) << r.out;
+  long long con[4];  // console: active, separated, sticking, sliding
+  const size_t at = r.out.find("\ncontact: ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + at, "\ncontact: %lld active, %lld separated, %lld sticking, %lld sliding", con,
+                        con + 1, con + 2, con + 3),
+            4);
+  const auto j = nlohmann::json::parse(slurp(json));
+  const long long js[4] = {j["contact"]["active"], j["contact"]["separated"], j["contact"]["sticking"],
+                           j["contact"]["sliding"]};
+  long long cs[4] = {0, 0, 0, 0};  // CSV: contact, stick columns
+  std::istringstream is(slurp(csv));
+  std::string line;
+  std::getline(is, line);
+  while (std::getline(is, line)) {
+    const int contact = line[line.size() - 3] - '0', stick = line[line.size() - 1] - '0';
+    cs[0] += contact;
+    cs[1] += 1 - contact;
+    cs[2] += stick;
+    cs[3] += contact - stick;
+    EXPECT_TRUE(contact || !stick) << "a separated node marked sticking: " << line;
+  }
+  long long vt[4] = {0, 0, 0, 0};  // the face VTU's contact_status: 1 separated, 2 stick, 3 slip (0 clamped)
+  const std::string face = slurp(dir + "states_contact.vtu");
+  const size_t a = face.find("Name=\"contact_status\"");
+  ASSERT_NE(a, std::string::npos);
+  std::istringstream codes(face.substr(face.find('>', a) + 1, face.find("</DataArray>", a) - face.find('>', a) - 1));
+  for (int code; codes >> code;) {
+    if (code == 1) vt[1] += 1;
+    if (code == 2) vt[2] += 1;
+    if (code == 3) vt[3] += 1;
+  }
+  vt[0] = vt[2] + vt[3];
+  EXPECT_GT(con[1], 0);
+  EXPECT_GT(con[2], 0);
+  EXPECT_GT(con[3], 0);
+  EXPECT_EQ(con[0], con[2] + con[3]);
+  EXPECT_EQ(con[0] + con[1], 84);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(js[k], con[k]) << "JSON, count " << k;
+    EXPECT_EQ(cs[k], con[k]) << "CSV, count " << k;
+    EXPECT_EQ(vt[k], con[k]) << "VTU, count " << k;
+  }
+}
+}  // namespace tresca

@@ -114,7 +114,8 @@ TEST_F(OutputFiles, ContactCsvRowsAreTheSolversValues) {
     EXPECT_EQ(v[8], R_->contact.phi[i]);
     EXPECT_EQ(v[9], R_->contact.gap[i]);
     EXPECT_EQ(v[10], (st[i] & kContact) ? 1 : 0);
-    EXPECT_EQ(v[11], (st[i] & kStick) ? 1 : 0);
+    // stick: sticking in contact (separation first, contact_state)
+    EXPECT_EQ(v[11], (st[i] & kContact) && (st[i] & kStick) ? 1 : 0);
   }
   EXPECT_EQ(rows, p);
 }

@@ -237,10 +237,11 @@ void write_contact_csv(OutputSet& out, const std::string& path, const Problem& P
   for (index i = 0; i < p; ++i) {
     const index ix = 1 + i % g.ex, iy = i / g.ex;
     const auto [x, y] = contact_position(g, i);
-    const std::uint8_t s = (*c.status)[i];
+    const ContactState s = contact_state((*c.status)[i]);  // separation first, as every output
     std::fprintf(f, "%lld,%lld,%.10g,%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d,%d\n", (long long)ix,
                  (long long)iy, x, y, (*c.u)[i], (*c.u)[p + i], (*c.u)[2 * p + i],
-                 (*c.lambda)[i], (*c.phi)[i], (*c.gap)[i], (s & kContact) ? 1 : 0, (s & kStick) ? 1 : 0);
+                 (*c.lambda)[i], (*c.phi)[i], (*c.gap)[i], s != ContactState::separated ? 1 : 0,
+                 s == ContactState::stick ? 1 : 0);
   }
 }
 

@@ -169,7 +169,8 @@ struct Piece {
   }
 };
 
-int status_code(std::uint8_t s) { return (s & kContact) ? ((s & kStick) ? 2 : 3) : 1; }
+// contact_status: 0 clamped (x = 0), 1 separated, 2 stick, 3 slip (contact_state)
+int status_code(std::uint8_t s) { return 1 + int(contact_state(s)); }
 
 }  // namespace
 
