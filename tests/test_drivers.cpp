@@ -415,3 +415,27 @@ TEST(TrescaDriver, EveryOutputCountsTheSameContactStates) {
   }
 }
 }  // namespace tresca
+
+namespace tresca {
+// Issue 19, item 6: a run's --json summary runs again as --problem (its
+// "problem" object is read, the rest ignored) and gives the same solution
+TEST(TrescaDriver, ARunSummaryRunsAgainAsAProblemFile) {
+  const std::string dir = std::string(TRESCA_BIN_DIR) + "/../";
+  const std::string a = dir + "roundtrip_a.json", b = dir + "roundtrip_b.json";
+  CmdResult r = run("tresca --dims 10x5x4 --coulomb 0.8 --obstacle sphere:2,1.1,0.5,0.001 --load-scale 0.7 --E 3e9 "
+                    "--quiet --json " + a);
+  ASSERT_EQ(r.status, 0) << r.out;
+  r = run("tresca --quiet --problem " + a + " --json " + b);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto ja = nlohmann::json::parse(slurp(a)), jb = nlohmann::json::parse(slurp(b));
+  EXPECT_EQ(ja["problem"], jb["problem"]);
+  EXPECT_EQ(ja["dims"], jb["dims"]);
+  EXPECT_EQ(ja["newton_iterations"], jb["newton_iterations"]);
+  EXPECT_EQ(ja["contact"], jb["contact"]);
+  // a file with a "problem" key that is no run summary is still checked key by key
+  std::ofstream(dir + "roundtrip_c.json") << "{\"problem\": {}, \"mesh\": {\"dims\": [4, 2, 2]}}";
+  r = run("tresca --quiet --problem " + dir + "roundtrip_c.json");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("'problem' is not a known key"), std::string::npos) << r.out;
+}
+}  // namespace tresca

@@ -63,6 +63,11 @@ ProblemFile parse_problem(const std::string& text, const std::string& origin) {
   } catch (const json::parse_error& e) {
     r.fail("", std::string("is not valid JSON: ") + e.what());
   }
+  // a run summary (tresca --json): its "problem" object, the rest ignored
+  if (j.is_object() && j.contains("residual_history") && j.contains("problem") && j["problem"].is_object()) {
+    const json inner = j["problem"];
+    j = inner;
+  }
   r.object(j, "", {"mesh", "box", "material", "loads", "friction", "obstacle"});
   ProblemFile f;
   ProblemSpec& s = f.spec;

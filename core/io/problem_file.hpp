@@ -17,8 +17,10 @@
 // Every error is one line naming the file and the key: unknown keys (a
 // typo must not silently leave a default), wrong types, bad values (the
 // problem's own checks, problem.hpp: validate), unreadable or malformed
-// files. The run summary repeats the problem in this same schema, so a
-// result file can be run again as a problem file.
+// files. The run summary repeats the problem in this same schema under
+// "problem", and a summary itself is accepted: its "problem" is read and the
+// rest ignored, so `--json run.json` then `--problem run.json` runs the same
+// case again.
 #pragma once
 #include <string>
 #include <vector>
