@@ -94,7 +94,6 @@ DenseNewton dense_newton(const Eigen::MatrixXd& S, const Eigen::VectorXd& bt, co
       const bool contact = kink_contact ? c >= 0 : c > 0;
       Winv.segment<4>(4 * i) << s, s, 1, 1 / s;
       const Eigen::Vector2d d12 = R.x.segment<2>(4 * i) + v.segment<2>(4 * i);
-      const real d4 = R.x[4 * i + 3] + v[4 * i + 3];
       if (d12.norm() == 0) {
         H.block<2, 2>(4 * i, 4 * i).setIdentity();
       } else {

@@ -8,6 +8,7 @@
 #include "core/parallel/comm.hpp"
 #include "core/parallel/distributed_multigrid.hpp"
 #include "core/parallel/row_fetch.hpp"
+#include "kernels/contact_maps.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
@@ -50,11 +51,19 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   // exist, so the peak memory stays this mesh's). It hands up (u, lambda)
   // as the Newton initial iterate and, trilinearly interpolated, its body
   // and K_ii^{-1} l_i as initial guesses of this mesh's first residual and |b̃|.
+  // A given initial iterate (a restart, a continuation) competes with the
+  // coarser mesh's solution: Newton starts from the one of smaller merit
+  // |w| (a continuation step in phi or load can leave the old solution
+  // further from the new one than the cheap coarse solve is).
   NewtonOptions newton = opt.newton;
+  const std::vector<real>* given_u0 = newton.u0;
+  const std::vector<real>* given_lambda0 = newton.lambda0;
+  newton.u0 = newton.lambda0 = nullptr;
   std::vector<real> u0, lambda0, load_guess, body;  // body: the guess at u0, then U = E u + K_ii^{-1} l_i
-  if (opt.nested && !newton.u0 && has_coarser(spec, opt.nested_min_contact_nodes)) {
+  if (opt.nested && has_coarser(spec, opt.nested_min_contact_nodes)) {
     const ProblemSpec cs = coarser_spec(spec);
     RunOptions co = opt;
+    co.newton.u0 = co.newton.lambda0 = nullptr;  // (a given iterate is this mesh's)
     co.recover_interior = true;
     co.keep_interior_load = true;
     co.newton.progress = nullptr;
@@ -113,9 +122,9 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
       opt.iterate_done(Iterate{R.problem.get(), step++, &whole, &u_full, &R.contact.gap, &rows});
     };
   }
-  // this rank's contact nodes (all of them on one rank): the law and a given initial iterate
+  // this rank's contact nodes (all of them on one rank): the law and the initial iterates
   ContactConditions law = R.contact;
-  std::vector<real> u0_local, lambda0_local;
+  std::vector<real> u0_local, lambda0_local, given_u0_local, given_lambda0_local;
   if (S.distributed()) {
     law.phi = S.local_part(R.contact.phi, 1);
     law.gap = S.local_part(R.contact.gap, 1);
@@ -124,6 +133,57 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
       lambda0_local = S.local_part(*newton.lambda0, 1);
       newton.u0 = &u0_local;
       newton.lambda0 = &lambda0_local;
+    }
+    if (given_u0 && given_lambda0) {
+      given_u0_local = S.local_part(*given_u0, 3);
+      given_lambda0_local = S.local_part(*given_lambda0, 1);
+      given_u0 = &given_u0_local;
+      given_lambda0 = &given_lambda0_local;
+    }
+  }
+  std::vector<real> given_body, r_coarse, r_given;
+  if (given_u0) {
+    if (!newton.u0) {
+      newton.u0 = given_u0;
+      newton.lambda0 = given_lambda0;
+    } else {
+      // both at the first residual's accuracy, each body warm for Newton
+      const std::vector<real> units = step_scale(S);
+      // (to 1e-2: the merits differ by factors; the winner's r, body and
+      // that accuracy go to Newton, which refines r where it needs to)
+      const real choice_rtol = 1e-2;
+      auto merit = [&](const std::vector<real>& u, const std::vector<real>& lambda, std::vector<real>& b,
+                       std::vector<real>& r, bool warm) {
+        const index p = S.contact_nodes();
+        std::vector<real> v(4 * p), w(4 * p), d(3 * p);
+        std::vector<std::uint8_t> st(p);
+        r.resize(3 * p);
+        b.resize(S.full_size());
+        const SolveStats st_r = S.residual(u.data(), r.data(), choice_rtol, b.data(), warm ? b.data() : nullptr);
+        R.choice_fine_matvecs += S.apply_work(st_r.iterations);
+        ContactConditions l = law;
+        if (opt.coulomb >= 0)
+          for (index i = 0; i < p; ++i) l.phi[i] = opt.coulomb * std::max(real(0), lambda[i]);
+        const ResidualNorms n = approximation_step(p, l.law(newton.kink_contact), nullptr, units.data(), u.data(),
+                                                   lambda.data(), r.data(), v.data(), w.data(), d.data(), st.data());
+        return std::sqrt(S.sum(n.consistent));
+      };
+      const real coarse = merit(*newton.u0, *newton.lambda0, body, r_coarse, true);
+      const real given = merit(*given_u0, *given_lambda0, given_body, r_given, false);
+      R.initial_iterate = given <= coarse ? "given" : "coarser mesh";
+      if (opt.phase_done) {
+        const std::string what = "initial iterate: the " + R.initial_iterate + "'s (|w| given " +
+                                 std::to_string(given) + " N, coarser mesh " + std::to_string(coarse) + " N)";
+        opt.phase_done(what.c_str(), 0);
+      }
+      if (given <= coarse) {
+        newton.u0 = given_u0;
+        newton.lambda0 = given_lambda0;
+        body = std::move(given_body);
+        r_coarse = std::move(r_given);
+      }
+      newton.r0 = &r_coarse;
+      newton.r0_accuracy = choice_rtol;
     }
   }
   // |b̃|, the scale of Newton's absolute accuracies and of the report: from
@@ -217,7 +277,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   const long long newton_inner = R.coulomb ? R.coulomb_loop.inner_iterations : R.newton.inner_iterations;
   R.inner_iterations = cond.iterations + newton_inner + R.report.inner.iterations;
   R.fine_matvecs_total = R.nested_fine_matvecs + R.newton_fine_matvecs() + S.apply_work(cond.iterations) +
-                         S.apply_work(R.report.inner.iterations);
+                         S.apply_work(R.report.inner.iterations) + R.choice_fine_matvecs;
   R.peak_memory = Comm::world().max(peak_memory_bytes());  // several ranks: the largest rank's
   // A failed Coulomb Newton solve is redone as the fixed point of Tresca
   // solves (each globalised by the line search), its work and time added to

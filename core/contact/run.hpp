@@ -130,6 +130,11 @@ struct RunResult {
   // fine_matvecs_total includes their work, scaled by their share of the dofs
   std::vector<NestedLevel> nested;
   double nested_fine_matvecs = 0;  // their work in this mesh's matvecs
+  // with a given initial iterate and nested iteration: which one Newton
+  // started from ("given" or "coarser mesh", the smaller merit |w|), and
+  // the two residuals that decided it (included in fine_matvecs_total)
+  std::string initial_iterate;
+  double choice_fine_matvecs = 0;
   long long newton_steps() const { return coulomb ? coulomb_loop.newton_steps : newton.iterations; }
   double newton_fine_matvecs() const { return coulomb ? coulomb_loop.fine_matvecs : newton.fine_matvecs; }
   double fine_matvecs_per_newton_step() const {

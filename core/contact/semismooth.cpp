@@ -345,7 +345,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
   R.force_scale = opt.force_scale > 0 ? opt.force_scale : std::sqrt(S.sum(dot(n3, R.r.data(), R.r.data())));
   if (!(R.force_scale > 0)) R.force_scale = 1;
   const real fscale = R.force_scale;
-  real r_err = (opt.r0 ? opt.residual_accuracy : opt.initial_residual_rtol) * fscale;
+  real r_err = (opt.r0 ? (opt.r0_accuracy > 0 ? opt.r0_accuracy : opt.residual_accuracy) : opt.initial_residual_rtol) *
+               fscale;
 
   const real* scale_ptr = scale.empty() ? nullptr : scale.data();
   // a trial point of the line search and the approximation step's scratch

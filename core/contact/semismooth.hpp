@@ -141,6 +141,7 @@ struct NewtonOptions {
   // optional, with body0 and force_scale: r0 = S u0 - b̃ of that body to
   // residual_accuracy, e.g. an earlier solve's NewtonResult::r and ::body
   const std::vector<real>* r0 = nullptr;
+  real r0_accuracy = 0;  // r0's accuracy relative to force_scale (0: residual_accuracy)
   // Coulomb with the bound lagged by one step: F >= 0 sets phi_i = F lambda_i
   // of the current iterate before every approximation step (the law's phi is
   // then ignored). ||v̂|| with that bound is the Coulomb problem's own

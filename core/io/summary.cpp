@@ -75,6 +75,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["newton_iterations"] = N.iterations;
   j["converged"] = R.converged();
   j["reason"] = R.reason();
+  j["initial_iterate"] = R.initial_iterate.empty() ? Json(nullptr) : Json(R.initial_iterate);
   j["stopping_rule"] = N.stop == StopRule::consistent ? "consistent" : "paper";
   j["tolerance"] = N.tolerance;
   j["residual_history"] = N.history;
