@@ -676,3 +676,26 @@ TEST(SemismoothNewton, ConvergedMeansItsOwnKKTCheckAgrees) {
   EXPECT_GT(test::max_abs_diff(P.newton.u, ref.newton.u), 1e-7 * umax);
 }
 }  // namespace tresca
+
+namespace tresca {
+// Issue 19, item 5: the headline work figure (fine-grid matvec equivalents)
+// against the solver's own counts: every S application is one inner solve of
+// `its` iterations, costing its (1 + V-cycle) + 2/nz (steklov.cpp), so with
+// no outer preconditioner the Newton work is inner_iterations (1 + cycle) +
+// applications 2/nz. Dropping any application's count breaks it.
+TEST(SemismoothNewton, CountedWorkIsTheCountedInnerSolves) {
+  const Problem P = make_problem(spec_for_dims(12, 6, 6));
+  const SteklovPoincare S(P);
+  NewtonOptions o;
+  o.outer_pc = OuterPreconditioner::none;
+  const ContactConditions law = ContactConditions::uniform(P.contact_nodes(), 3e6, 0);
+  const NewtonResult R = semismooth_newton(S, law, o);
+  ASSERT_TRUE(R.converged());
+  const double per_apply = S.apply_work(0), per_iteration = S.apply_work(1) - per_apply;
+  EXPECT_GT(per_iteration, 1.0);
+  EXPECT_NEAR(per_apply, 2.0 / double(P.grid.nz()), 1e-12);
+  EXPECT_GT(R.operator_applications, R.outer_iterations);
+  EXPECT_NEAR(R.fine_matvecs, double(R.inner_iterations) * per_iteration + double(R.operator_applications) * per_apply,
+              1e-9 * R.fine_matvecs);
+}
+}  // namespace tresca

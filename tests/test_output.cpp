@@ -204,6 +204,24 @@ TEST_F(OutputFiles, VtuHoldsTheSolversFieldsOnPositiveVolumeHexahedra) {
     EXPECT_NEAR(cl[n], cid[n] < 0 ? 0.0 : R_->newton.lambda[cid[n]], 1e-11 * std::abs(R_->report.lambda_sum));
     EXPECT_EQ(cc[n], cid[n] < 0 ? 0 : status_code(R_->report.status[cid[n]]));
   }
+  // its quads: each the face's element, its corners in order around it
+  // (a bow-tie has signed area 0), all facing the same way, tiling the face
+  const auto fp = data_array(vc, "", "<Points>");
+  const auto fconn = data_array(vc, "connectivity");
+  ASSERT_EQ(index(fp.size()), 3 * M);
+  ASSERT_EQ(index(fconn.size()), 4 * g.ex * g.ey);
+  double total = 0;
+  for (size_t c = 0; c < fconn.size() / 4; ++c) {
+    double area = 0;  // shoelace in the xy plane
+    for (int k = 0; k < 4; ++k) {
+      const size_t a = size_t(fconn[4 * c + k]), b = size_t(fconn[4 * c + (k + 1) % 4]);
+      ASSERT_NEAR(fp[3 * a + 2], P.grid.z0, 1e-12) << "quad " << c << " leaves the contact plane";
+      area += 0.5 * (fp[3 * a] * fp[3 * b + 1] - fp[3 * b] * fp[3 * a + 1]);
+    }
+    ASSERT_NEAR(area, g.hx() * g.hy(), 1e-9 * g.hx() * g.hy()) << "quad " << c;
+    total += area;
+  }
+  EXPECT_NEAR(total, g.ex * g.hx() * g.ey * g.hy(), 1e-9);
 }
 
 TEST_F(OutputFiles, JsonSummaryRepeatsTheSolution) {
