@@ -4,7 +4,9 @@ solution: contact CSV values within a relative tolerance of each column's
 largest magnitude, the same contact and stick sets, and the same Newton
 iteration count in the JSON summaries.
 
-usage: compare_runs.py A.csv A.json B.csv B.json RTOL"""
+With "mixed": the case must have separated, sticking and sliding nodes.
+
+usage: compare_runs.py A.csv A.json B.csv B.json RTOL [mixed]"""
 import csv
 import json
 import sys
@@ -30,6 +32,12 @@ def main():
         same = all(x[col] == y[col] for x, y in zip(a, b))
         print(f"{col} sets equal: {same}")
         ok = ok and same
+    if len(sys.argv) > 6 and sys.argv[6] == "mixed":
+        sep = sum(r["contact"] == "0" for r in a)
+        stick = sum(r["contact"] == "1" and r["stick"] == "1" for r in a)
+        slip = sum(r["contact"] == "1" and r["stick"] == "0" for r in a)
+        print(f"states: {sep} separated, {stick} stick, {slip} slip")
+        ok = ok and sep > 0 and stick > 0 and slip > 0
     ja, jb = json.load(open(a_json)), json.load(open(b_json))
     print(f"Newton iterations {ja['newton_iterations']} vs {jb['newton_iterations']}, "
           f"ranks {ja.get('ranks')} vs {jb.get('ranks')}, converged {ja['converged']} / {jb['converged']}")
