@@ -82,6 +82,30 @@ TEST(DistributedElasticity, OwnedRowsOfTheApplyEqualTheWholeGridsBitForBit) {
   }
 }
 
+// the contact planes (z = 0 and 1, what S needs of K): the owned rows of
+// the distributed apply_planes equal the whole grid's, and the planes
+// outside the range are left untouched (issue 19)
+TEST(DistributedElasticity, ApplyPlanesEqualsTheWholeGridsOnItsPlanesOnly) {
+  for (const GridDims& g : {test::prism(8, 8, 4), test::prism(7, 5, 3)}) {
+    if (g.ny() < world().size()) continue;
+    const Slab s = make_slab(g, world().rank(), world().size());
+    const std::vector<real> xg = test::random_vector(3 * g.nodes(), 5);
+    std::vector<real> yg(xg.size(), 7.0);
+    ElasticityOperator(g, kFaces, 2.1e9, 0.277).apply_planes(xg.data(), yg.data(), 0, 2);
+    DistributedElasticity K(s, kFaces, 2.1e9, 0.277);
+    std::vector<real> x(K.size()), y(K.size(), 7.0);
+    global_to_local(s, xg.data(), x.data());
+    K.zero_ghosts(x.data());  // the ghosts must come from the exchange
+    K.apply_planes(x.data(), y.data(), 0, 2);
+    EXPECT_EQ(max_owned_diff(s, y, yg), 0.0) << g.ex << "x" << g.ey << "x" << g.ez;
+    const GridDims& l = s.local;
+    for (int c = 0; c < 3; ++c)
+      for (index iz = 2; iz < l.nz(); ++iz)
+        for (index iy = s.lo; iy < s.lo + s.owned_rows(); ++iy)
+          for (index ix = 0; ix < l.nx(); ++ix) ASSERT_EQ(y[c * l.nodes() + l.node(ix, iy, iz)], 7.0) << "plane " << iz;
+  }
+}
+
 TEST(DistributedElasticity, ExchangeFillsTheGhostRowsAndCountsAsTheModelSays) {
   const GridDims g = test::prism(9, 10, 4);
   if (g.ny() < world().size()) GTEST_SKIP();
