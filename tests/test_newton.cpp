@@ -267,6 +267,31 @@ void compare_with_dense(const NewtonOptions& method, index ex, index ey, index e
   const Eigen::VectorXd rd = D.S * uc - D.b;
   EXPECT_LT(test::max_abs_diff(R.newton.r, F.r), 1e-10 * fscale);
   for (index i = 0; i < 3 * p; ++i) EXPECT_NEAR(F.r[i], rd[i], 1e-9 * fscale) << "i=" << i;
+  // every KKT field of the report, recomputed here from the dense r
+  {
+    real eq = 0, pen = 0, neg = 0, comp = 0, bound = 0, dir = 0, slip = 0;
+    for (index i = 0; i < p; ++i) {
+      const real ux = R.newton.u[i], uy = R.newton.u[p + i], uz = R.newton.u[2 * p + i], lam = R.newton.lambda[i];
+      const real ut = std::hypot(ux, uy), s = R.newton.units[i];
+      eq = std::max(eq, std::abs(rd[2 * p + i] - lam));
+      pen = std::max(pen, -(uz + gap));
+      neg = std::max(neg, -lam);
+      comp = std::max(comp, std::abs(lam * (uz + gap)));
+      bound = std::max(bound, std::hypot(rd[i], rd[p + i]) - phi[i]);
+      if (F.status[i] & kStick)
+        slip = std::max(slip, ut);
+      else if (s * ut > F.tolerance)
+        dir = std::max(dir, std::hypot(rd[i] + phi[i] * ux / ut, rd[p + i] + phi[i] * uy / ut));
+    }
+    const real f = 2e-9 * fscale;
+    EXPECT_NEAR(F.equilibrium, eq, f);
+    EXPECT_NEAR(F.uz_violation, std::max(pen, real(0)), 1e-15);
+    EXPECT_NEAR(F.lambda_violation, std::max(neg, real(0)), f);
+    EXPECT_NEAR(F.complementarity, comp, f * umax);
+    EXPECT_NEAR(F.friction_bound, std::max(bound, real(0)), f);
+    EXPECT_NEAR(F.friction_direction, dir, f + 1e-6 * dir);
+    EXPECT_EQ(F.stick_slip, slip);
+  }
   EXPECT_LT(F.equilibrium, 1e-10 * fscale);
   EXPECT_LT(F.uz_violation, 1e-12);
   EXPECT_LT(F.lambda_violation, 1e-10 * fscale);
