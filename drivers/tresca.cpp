@@ -40,14 +40,16 @@ const char* kHelp =
     "  --load-scale S     multiplies all loads (default 1)\n"
     "  --initial F.csv    start Newton from the contact displacement and pressure of a\n"
     "                     --contact-csv file of the same mesh (columns ix,iy,ux,uy,uz,lambda;\n"
-    "                     continuation in phi or load, or a restart); no nested iteration\n"
+    "                     continuation in phi or load, or a restart); the coarser meshes are\n"
+    "                     solved too and Newton starts from whichever has the smaller |w|\n"
     "  --coulomb F        Coulomb friction, bound phi_i = F lambda_i per contact node (F >= 0),\n"
     "                     excludes --phi\n"
     "  --coulomb-method newton|lagged|fixed-point  one Newton solve whose step differentiates\n"
     "                     phi = F lambda (default; boundary GMRES), one whose bound follows lambda\n"
     "                     a step late (symmetric, CG), or a fixed point of whole Tresca solves\n"
     "  --gap G            the rigid plane lies G >= 0 metres below the contact face (default 0)\n"
-    "  --eps E            stopping tolerance on ||v|| (default 1e-6, absolute)\n"
+    "  --eps E            stopping tolerance on |w| [N], the residual in consistent units\n"
+    "                     (default 1e-6, absolute; --table: on the paper's |v|, its rule (11))\n"
     "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
     "  --max-newton N     Newton iteration limit (default 50)\n"
     "  --scaling paper|diagonal  metric of the approximation step: the paper's (forces and\n"
@@ -72,6 +74,8 @@ const char* kHelp =
     "  --profile          per-kernel time, GB/s and GFLOP/s after the run\n"
     "  --quiet            no progress lines\n"
     "  --help             this text\n"
+    "A run is converged only if its final KKT check agrees (else reason kkt_check_failed).\n"
+    "Contact states, separation first: separated, stick (in contact), slip (in contact).\n"
     "Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure, 4 out of memory.\n";
 
 // The paper's Table 1 (MATLAB): level, n, assembly [s], Cholesky & Schur [s], p, solver [s], iterations
