@@ -4,7 +4,9 @@
 // Iteration k, x = (u, lambda), r = S u − b̃ (the contact forces that hold
 // the body at u) and the body's displacement U = E u + K_ii^{-1} l_i:
 //  1. approximation step (kernels/contact_maps.hpp) at scale s → d̂, node
-//     status; the paper's v̂ (s = 1) for the stopping rule ||v̂||_2 <= eps (11);
+//     status; the residual in consistent units |w| [N] for the stopping rule
+//     |w| <= eps (the paper's |v̂| <= eps (11) with StopRule::paper) and as
+//     the line search's merit;
 //  2. Newton step (9)–(10) in reduced form, with v = d̂ − x the step's
 //     increments: known Δu_τ = v_12 (sticking), Δu_z = v_4/s (contact),
 //     Δλ = v_4 (separated); free dofs F = u_τ of sliding nodes, u_z of
@@ -13,8 +15,11 @@
 //     with r = (s I + H_1) v_12 on sliding rows, v_3 + v_4 on separated rows,
 //     by CG preconditioned with BoundaryPreconditioner; then
 //     Δλ = (S Δu)_z − v_3 on contact nodes.
-//  3. r += S Δu, U += E Δu, from one application of S to the whole step,
-//     warm from the outer CG's running E Δu.
+//  3. S Δu and E Δu from one application of S to the whole step, warm from
+//     the outer CG's running E Δu; then the step's length alpha by the
+//     non-monotone line search on |w| (NewtonOptions::line_search; r, lambda
+//     and U are linear along the step, so trial points cost no solve):
+//     x += alpha Δ, r += alpha S Δu, U += alpha E Δu.
 // Tolerances. The step is inexact: CG stops at eta_k |r_F| (forcing term,
 // Eisenstat–Walker choice 2: eta_0 = forcing_max, then 0.9 (|v̂_k|/|v̂_k-1|)²,
 // safeguarded, so eta_k -> 0 and the convergence stays superlinear), floored
