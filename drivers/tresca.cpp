@@ -334,6 +334,10 @@ int main(int argc, char** argv) {
       return all ? 0 : 1;
     }
 
+    const ThreadPlacement placement = thread_placement();
+    if (placement.cpus < int(placement.thread_cpus.size()))
+      std::fprintf(stderr, "tresca: warning: %d OpenMP threads may run on only %d CPUs (%s): they will share them\n",
+                   int(placement.thread_cpus.size()), placement.cpus, placement.describe().c_str());
     if (!quiet) {
       char friction[64];
       if (opt.coulomb >= 0)
@@ -348,6 +352,7 @@ int main(int argc, char** argv) {
       std::printf("        estimated peak memory %.2f GB%s; kernels: %s; %s\n",
                   estimated_memory_bytes_per_rank(spec, comm.size()) / 1e9, comm.distributed() ? " per rank" : "",
                   build_info().c_str(), omp_wait_setting().c_str());
+      std::printf("        %s\n", placement.describe().c_str());
     }
     // --vtk-every-iteration: the iterates' files, published with the run's others
     OutputSet out;

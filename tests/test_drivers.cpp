@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace tresca {
 
@@ -465,5 +466,31 @@ TEST(TrescaDriver, AWarmRestartCostsAtMostTheColdStart) {
   work("--contact-csv " + csv);
   const double cold_load = work("--load-scale 2"), warm_load = work("--load-scale 2 --initial " + csv);
   EXPECT_LE(warm_load, 1.05 * cold_load) << "load 1 -> 2";
+}
+}  // namespace tresca
+
+namespace tresca {
+// Issue 21, item 1: the user's OpenMP placement is honoured. The drivers
+// used to re-execute themselves to set runtime variables, and the new
+// process inherited the one-CPU mask libgomp had given the initial thread:
+// with OMP_PROC_BIND=close OMP_PLACES=cores every thread ran on CPU 0.
+TEST(TrescaDriver, HonoursTheUsersThreadPlacement) {
+  const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  if (cores < 2) GTEST_SKIP() << "one CPU: no placement to check";
+  const std::string json = ::testing::TempDir() + "placement.json";
+  const CmdResult r = run("tresca --dims 8x4x4 --json " + json, "OMP_PROC_BIND=close OMP_PLACES=cores OMP_NUM_THREADS=2");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("OMP_PROC_BIND=close"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("warning"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(slurp(json));
+  const auto& t = j["placement"]["thread_cpus"];
+  ASSERT_EQ(t.size(), 2u) << j["placement"];
+  EXPECT_NE(t[0], t[1]) << "both threads on one place: " << j["placement"];
+  EXPECT_EQ(j["placement"]["cpus"], 2) << j["placement"];
+  EXPECT_EQ(j["placement"]["runtime_defaults_applied"], false);
+  // more threads than the CPUs they may use: a warning
+  const CmdResult w = run("tresca --dims 8x4x4 --quiet", "OMP_PROC_BIND=close OMP_PLACES='{0}' OMP_NUM_THREADS=2");
+  EXPECT_EQ(w.status, 0) << w.out;
+  EXPECT_NE(w.out.find("2 OpenMP threads may run on only 1 CPUs"), std::string::npos) << w.out;
 }
 }  // namespace tresca

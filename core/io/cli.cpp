@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <utility>
 #include <omp.h>
+#include <sched.h>
 #include <unistd.h>
 #include <fstream>
 #include <sys/resource.h>
@@ -230,7 +231,64 @@ bool cores_free_at_start() {
 }
 }  // namespace
 
+namespace {
+bool user_placed_threads() {
+  for (const char* v : {"OMP_PROC_BIND", "OMP_PLACES", "GOMP_CPU_AFFINITY", "VALGRIND_LAUNCHER"})
+    if (std::getenv(v)) return true;
+  return false;
+}
+bool defaults_applied = false;
+
+// "0-3,8" from a CPU set
+std::string cpu_list(const cpu_set_t& set) {
+  std::string out;
+  for (int c = 0; c < CPU_SETSIZE; ++c) {
+    if (!CPU_ISSET(c, &set)) continue;
+    int e = c;
+    while (e + 1 < CPU_SETSIZE && CPU_ISSET(e + 1, &set)) ++e;
+    if (!out.empty()) out += ",";
+    out += std::to_string(c) + (e > c ? "-" + std::to_string(e) : "");
+    c = e;
+  }
+  return out;
+}
+}  // namespace
+
+ThreadPlacement thread_placement() {
+  ThreadPlacement t;
+  const int n = omp_get_max_threads();
+  t.thread_cpus.assign(n, "");
+  std::vector<cpu_set_t> sets(n);
+#pragma omp parallel num_threads(n)
+  {
+    const int i = omp_get_thread_num();
+    CPU_ZERO(&sets[i]);
+    if (sched_getaffinity(0, sizeof(cpu_set_t), &sets[i]) == 0) t.thread_cpus[i] = cpu_list(sets[i]);
+  }
+  cpu_set_t all;
+  CPU_ZERO(&all);
+  for (const cpu_set_t& s : sets) CPU_OR(&all, &all, &s);
+  t.cpus = CPU_COUNT(&all);
+  if (const char* b = std::getenv("OMP_PROC_BIND")) t.proc_bind = b;
+  if (const char* p = std::getenv("OMP_PLACES")) t.places = p;
+  t.defaults_applied = defaults_applied;
+  return t;
+}
+
+std::string ThreadPlacement::describe() const {
+  std::ostringstream os;
+  os << thread_cpus.size() << " threads on CPUs";
+  for (size_t i = 0; i < thread_cpus.size(); ++i) os << (i ? " " : " ") << i << ":{" << thread_cpus[i] << "}";
+  if (!proc_bind.empty()) os << ", OMP_PROC_BIND=" << proc_bind;
+  if (!places.empty()) os << ", OMP_PLACES=" << places;
+  if (!defaults_applied) os << "; runtime defaults not applied (environment as given)";
+  return os.str();
+}
+
 void default_runtime_environment(char** argv) {
+  // a re-executed child (or a user who set all three) finds them set
+  defaults_applied = std::getenv("GLIBC_TUNABLES") && std::getenv("OMP_WAIT_POLICY");
+  if (user_placed_threads()) return;
   bool changed = false;
   auto set_default = [&](const char* name, const char* value) {
     if (!std::getenv(name)) {

@@ -49,7 +49,25 @@ void check_memory(const ProblemSpec& s);
 //   pages (where the kernel's THP mode is "madvise", as on Debian). First
 //   touch of the large arrays costs 512x fewer page faults: level 11 setup
 //   1.7 -> 0.7 s, the whole run 13.6 -> 9.9 s (perf/RESULTS.md §0d).
+// The drivers set these by re-executing themselves (the runtime reads them
+// before main), except where the user placed the threads (OMP_PROC_BIND,
+// OMP_PLACES, GOMP_CPU_AFFINITY) or the program runs under valgrind: libgomp
+// binds the initial thread at start-up, and a re-executed process would
+// inherit that one-CPU mask for all its threads (issue 21). Those runs keep
+// the environment as given; thread_placement() says where threads run.
 void default_runtime_environment(char** argv);
+// Where this process's OpenMP threads may run: each thread's allowed CPUs
+// (sched_getaffinity, as a list like "0-3,8"), how many distinct CPUs they
+// cover, the user's OMP_PROC_BIND / OMP_PLACES (empty if unset), and
+// whether the runtime defaults above were applied.
+struct ThreadPlacement {
+  std::vector<std::string> thread_cpus;
+  int cpus = 0;
+  std::string proc_bind, places;
+  bool defaults_applied = false;
+  std::string describe() const;  // one line for the run's header
+};
+ThreadPlacement thread_placement();
 // how idle OpenMP threads wait in this process: "OMP_WAIT_POLICY=...,
 // GOMP_SPINCOUNT=..." as the runtime read them (printed and in the JSON)
 std::string omp_wait_setting();
