@@ -233,9 +233,12 @@ bool cores_free_at_start() {
 
 namespace {
 bool user_placed_threads() {
-  for (const char* v : {"OMP_PROC_BIND", "OMP_PLACES", "GOMP_CPU_AFFINITY", "VALGRIND_LAUNCHER"})
+  for (const char* v : {"OMP_PROC_BIND", "OMP_PLACES", "GOMP_CPU_AFFINITY"})
     if (std::getenv(v)) return true;
-  return false;
+  // valgrind runs the program inside its tool (whose /proc/self/exe a
+  // re-exec would start) and preloads its core library into it
+  const char* preload = std::getenv("LD_PRELOAD");
+  return preload && std::string(preload).find("vgpreload") != std::string::npos;
 }
 bool defaults_applied = false;
 
