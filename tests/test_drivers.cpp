@@ -448,7 +448,7 @@ namespace tresca {
 // coarser mesh's solution (run.cpp). Level 7: phi 2e5 -> 3e5 used to cost
 // 11,465 fine matvecs against 1,224 cold (Newton stagnated, then redid it
 // from x0 = 0). The choice's own cost is the losing candidate's loose
-// residual (load 1 -> 2: 2 %).
+// residual (load 1 -> 2: 4 %).
 TEST(TrescaDriver, AWarmRestartCostsAtMostTheColdStart) {
   const std::string dir = ::testing::TempDir(), csv = dir + "warm.csv", json = dir + "warm.json";
   auto work = [&](const std::string& args) {
@@ -466,7 +466,7 @@ TEST(TrescaDriver, AWarmRestartCostsAtMostTheColdStart) {
   EXPECT_LE(warm_near, 0.9 * cold_near) << "phi 3e5 -> 3.1e5";
   work("--contact-csv " + csv);
   const double cold_load = work("--load-scale 2"), warm_load = work("--load-scale 2 --initial " + csv);
-  EXPECT_LE(warm_load, 1.03 * cold_load) << "load 1 -> 2";
+  EXPECT_LE(warm_load, 1.05 * cold_load) << "load 1 -> 2";
 }
 }  // namespace tresca
 

@@ -151,15 +151,15 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
       const std::vector<real> units = step_scale(S);
       // (to 1e-2: the merits differ by factors; the winner's r, body and
       // that accuracy go to Newton, which refines r where it needs to)
-      const real choice_rtol = 1e-2, given_rtol = 1e-1;  // (the given's cold solve: the looser)
+      const real choice_rtol = 1e-2;
       auto merit = [&](const std::vector<real>& u, const std::vector<real>& lambda, std::vector<real>& b,
-                       std::vector<real>& r, bool warm, real rtol) {
+                       std::vector<real>& r, bool warm) {
         const index p = S.contact_nodes();
         std::vector<real> v(4 * p), w(4 * p), d(3 * p);
         std::vector<std::uint8_t> st(p);
         r.resize(3 * p);
         b.resize(S.full_size());
-        const SolveStats st_r = S.residual(u.data(), r.data(), rtol, b.data(), warm ? b.data() : nullptr);
+        const SolveStats st_r = S.residual(u.data(), r.data(), choice_rtol, b.data(), warm ? b.data() : nullptr);
         R.choice_fine_matvecs += S.apply_work(st_r.iterations);
         ContactConditions l = law;
         if (opt.coulomb >= 0)
@@ -168,8 +168,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
                                                    lambda.data(), r.data(), v.data(), w.data(), d.data(), st.data());
         return std::sqrt(S.sum(n.consistent));
       };
-      const real coarse = merit(*newton.u0, *newton.lambda0, body, r_coarse, true, choice_rtol);
-      const real given = merit(*given_u0, *given_lambda0, given_body, r_given, false, given_rtol);
+      const real coarse = merit(*newton.u0, *newton.lambda0, body, r_coarse, true);
+      const real given = merit(*given_u0, *given_lambda0, given_body, r_given, false);
       R.initial_iterate = given <= coarse ? "given" : "coarser mesh";
       if (opt.phase_done) {
         const std::string what = "initial iterate: the " + R.initial_iterate + "'s (|w| given " +
@@ -183,7 +183,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
         r_coarse = std::move(r_given);
       }
       newton.r0 = &r_coarse;
-      newton.r0_accuracy = given <= coarse ? given_rtol : choice_rtol;
+      newton.r0_accuracy = choice_rtol;
     }
   }
   // |b̃|, the scale of Newton's absolute accuracies and of the report: from
