@@ -26,7 +26,10 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, ContactConditions la
   const index p = S.size() / 3;
   CoulombResult C;
   NewtonOptions no = newton;
-  for (index i = 0; i < p; ++i) law.phi[i] = newton.lambda0 ? co.F * std::max(real(0), (*newton.lambda0)[i]) : 0;
+  if (newton.lambda0)
+    law.set_coulomb_bound(co.F, *newton.lambda0);
+  else
+    std::fill(law.phi.begin(), law.phi.end(), real(0));
   // the first solve and the last go to eps; in between, a solve stops at
   // rtol = 0.1 * the last change of phi (the tolerances tighten together)
   real change = INFINITY;

@@ -49,11 +49,6 @@ FinalReport final_report(const SteklovPoincare& S, const ContactConditions& law,
     const real rt = std::hypot(rx, ry), ut = std::hypot(ux, uy);
     F.friction_bound = std::max(F.friction_bound, rt - phi[i]);
     real worst = std::max({eq, s * pen, neg, std::min(std::abs(lam), s * std::abs(uz + gap)), rt - phi[i]});
-    switch (contact_state(F.status[i])) {
-      case ContactState::separated: F.separated += 1; break;
-      case ContactState::stick: F.sticking += 1; break;
-      case ContactState::slip: F.sliding += 1; break;
-    }
     // Tresca's friction law holds at every node, in contact or not
     if (F.status[i] & kStick) {
       F.stick_slip = std::max(F.stick_slip, ut);
@@ -70,13 +65,17 @@ FinalReport final_report(const SteklovPoincare& S, const ContactConditions& law,
     F.uz_max = std::max(F.uz_max, uz);
     F.lambda_sum += lam;
   }
-  F.active = F.sticking + F.sliding;
+  const StateCounts states = count_states(p, F.status.data());
+  F.separated = states.separated;
+  F.sticking = states.stick;
+  F.sliding = states.slip;
   // over all ranks (each holds its own contact nodes; identity on one rank)
   for (real* m : {&F.equilibrium, &F.uz_violation, &F.lambda_violation, &F.complementarity, &F.friction_bound,
                   &F.friction_direction, &F.stick_slip, &F.uz_max, &F.kkt_force})
     *m = S.max(*m);
   F.ux_min = -S.max(-F.ux_min);
-  for (index* c : {&F.active, &F.separated, &F.sticking, &F.sliding, &F.slip_unresolved}) *c = index(S.sum(real(*c)));
+  for (index* c : {&F.separated, &F.sticking, &F.sliding, &F.slip_unresolved}) *c = index(S.sum(real(*c)));
+  F.active = F.sticking + F.sliding;
   F.lambda_sum = S.sum(F.lambda_sum);
   F.friction_bound = std::max(F.friction_bound, real(0));
   F.kkt_ok = F.kkt_force <= tol && F.true_residual_consistent <= tol;

@@ -162,8 +162,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
         const SolveStats st_r = S.residual(u.data(), r.data(), choice_rtol, b.data(), warm ? b.data() : nullptr);
         R.choice_fine_matvecs += S.apply_work(st_r.iterations);
         ContactConditions l = law;
-        if (opt.coulomb >= 0)
-          for (index i = 0; i < p; ++i) l.phi[i] = opt.coulomb * std::max(real(0), lambda[i]);
+        if (opt.coulomb >= 0) l.set_coulomb_bound(opt.coulomb, lambda);
         const ResidualNorms n = approximation_step(p, l.law(newton.kink_contact), nullptr, units.data(), u.data(),
                                                    lambda.data(), r.data(), v.data(), w.data(), d.data(), st.data());
         return std::sqrt(S.sum(n.consistent));

@@ -349,25 +349,27 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
                fscale;
 
   const real* scale_ptr = scale.empty() ? nullptr : scale.data();
-  // a trial point of the line search and the approximation step's scratch
+  // a trial point of the line search (with its own law: Coulomb's bound of
+  // a rejected trial must not outlive it) and the approximation step's scratch
   struct Trial {
     std::vector<real> u, lambda, r, v, w, d;
     std::vector<std::uint8_t> status;
+    ContactConditions law;
   } trial{std::vector<real>(n3), std::vector<real>(p), std::vector<real>(n3), std::vector<real>(4 * p),
-          std::vector<real>(4 * p), std::vector<real>(3 * p), std::vector<std::uint8_t>(p)};
+          std::vector<real>(4 * p), std::vector<real>(3 * p), std::vector<std::uint8_t>(p), law};
   // side: [S Δu | E Δu] of the step; known_side: the same of its known increments
   std::vector<real> v(4 * p), d(3 * p), du(n3), side(n3 + nf), known_side(n3 + nf), dlambda(p);
   // the residual in consistent units is measured in the stiffness of the
   // diagonal metric whatever the step's metric
   const real* units = diagonal_scale.data();
-  // the approximation step at (u, lambda, r) with the law's bound (Coulomb:
+  // the approximation step at (u, lambda, r) with the bound of `at` (Coulomb:
   // phi_i = F lambda_i of that iterate): v̂, d and status into the given arrays
-  auto residual_at = [&](const std::vector<real>& u, const std::vector<real>& lambda, const std::vector<real>& r,
-                         std::vector<real>& vv, std::vector<real>& dd, std::vector<std::uint8_t>& st) {
-    if (opt.coulomb >= 0)
-      for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * std::max(real(0), lambda[i]);
-    return approximation_step(p, law.law(opt.kink_contact), scale_ptr, units, u.data(), lambda.data(), r.data(), vv.data(),
-                              trial.w.data(), dd.data(), st.data());
+  auto residual_at = [&](ContactConditions& at, const std::vector<real>& u, const std::vector<real>& lambda,
+                         const std::vector<real>& r, std::vector<real>& vv, std::vector<real>& dd,
+                         std::vector<std::uint8_t>& st) {
+    if (opt.coulomb >= 0) at.set_coulomb_bound(opt.coulomb, lambda);
+    return approximation_step(p, at.law(opt.kink_contact), scale_ptr, units, u.data(), lambda.data(), r.data(),
+                              vv.data(), trial.w.data(), dd.data(), st.data());
   };
   ReducedSystem L(n3);
   std::unique_ptr<BoundaryPreconditioner> M;
@@ -391,7 +393,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
     for (int pass = 0;; ++pass) {
       {
         ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
-        const ResidualNorms norms = residual_at(R.u, R.lambda, R.r, v, d, R.status);
+        const ResidualNorms norms = residual_at(law, R.u, R.lambda, R.r, v, d, R.status);
         merit = std::sqrt(S.sum(norms.consistent));
         vnorm = opt.stop == StopRule::consistent ? merit : std::sqrt(S.sum(norms.paper));
         if (opt.coulomb >= 0 && opt.coulomb_newton) {
@@ -505,7 +507,8 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
         for (index i = 0; i < p; ++i) trial.lambda[i] = R.lambda[i] + alpha * dlambda[i];
         ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
         const real m_trial =
-            std::sqrt(S.sum(residual_at(trial.u, trial.lambda, trial.r, trial.v, trial.d, trial.status).consistent));
+            std::sqrt(S.sum(residual_at(trial.law, trial.u, trial.lambda, trial.r, trial.v, trial.d, trial.status)
+                                .consistent));
         accepted = m_trial <= (1 - 1e-4 * alpha) * reference;
         if (!accepted) alpha *= 0.5;
       }
