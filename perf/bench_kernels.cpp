@@ -7,7 +7,7 @@
 
 #include <vector>
 
-#include "core/solvers/multigrid.hpp"
+#include "core/multigrid/multigrid.hpp"
 #include "core/fem/problem.hpp"
 #include "kernels/simd.hpp"
 #include "kernels/transfer.hpp"

@@ -5,7 +5,7 @@
 #include <exception>
 
 #include "core/io/cli.hpp"
-#include "core/fem/interior.hpp"
+#include "core/multigrid/interior.hpp"
 #include "core/io/output.hpp"
 #include "core/util/profile.hpp"
 #include "kernels/simd.hpp"

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "core/io/cli.hpp"
-#include "core/solvers/multigrid.hpp"
+#include "core/multigrid/multigrid.hpp"
 #include "core/io/output.hpp"
 #include "core/fem/problem.hpp"
 #include "core/util/profile.hpp"

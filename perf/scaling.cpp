@@ -18,7 +18,7 @@
 #include "core/io/cli.hpp"
 #include "core/io/output.hpp"
 #include "core/io/summary.hpp"
-#include "core/fem/interior.hpp"
+#include "core/multigrid/interior.hpp"
 #include "core/util/profile.hpp"
 #include "core/contact/run.hpp"
 #include "kernels/simd.hpp"

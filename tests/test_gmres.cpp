@@ -8,7 +8,7 @@
 
 #include "core/fem/problem.hpp"
 #include "core/solvers/gmres.hpp"
-#include "core/solvers/multigrid.hpp"
+#include "core/multigrid/multigrid.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"
 

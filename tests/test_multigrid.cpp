@@ -5,8 +5,8 @@
 #include <Eigen/SparseCholesky>
 
 #include "core/solvers/cg.hpp"
-#include "core/fem/interior.hpp"
-#include "core/solvers/multigrid.hpp"
+#include "core/multigrid/interior.hpp"
+#include "core/multigrid/multigrid.hpp"
 #include "core/fem/problem.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"
@@ -117,7 +117,7 @@ TEST(MultigridCG, HierarchyIsSharedAndTheOperatorComesFromItsDescription) {
   }
   // an operator that does not live on the hierarchy's grids is refused
   const GridDims other = test::prism(5, 3, 3);
-  EXPECT_THROW(Multigrid(grids, [&](const GridDims&) { return ElasticityOperator(other, kFaceX0, 1, 0.3); }, mo),
+  EXPECT_THROW(Multigrid(grids, [&](const Slab&) { return ElasticityOperator(other, kFaceX0, 1, 0.3); }, mo),
                std::invalid_argument);
 }
 

@@ -15,12 +15,8 @@ BoundaryPreconditioner::BoundaryPreconditioner(const SteklovPoincare& S, const M
     : S_(S), kdiag_(S.contact_diagonal()) {
   const Problem& P = S.problem();
   // the K_ii solver's grids, transfers and smoother bounds
-  if (S.distributed())
-    dmg_ = std::make_unique<DistributedMultigrid>(P.grid, P.dirichlet_faces, P.spec.E, P.spec.nu, mg, S.comm(), 2048,
-                                                  &S.distributed_multigrid());
-  else
-    mg_ = std::make_unique<Multigrid>(S.interior_multigrid().hierarchy(),
-                                      elasticity_on(P.dirichlet_faces, P.spec.E, P.spec.nu), mg, S.interior_multigrid());
+  mg_ = std::make_unique<Multigrid>(S.interior_multigrid().hierarchy(),
+                                    elasticity_on(P.dirichlet_faces, P.spec.E, P.spec.nu), mg, &S.interior_multigrid());
   full_in_.assign(S.full_size(), 0);
   full_out_.assign(S.full_size(), 0);
 }
@@ -43,12 +39,8 @@ void BoundaryPreconditioner::update(const std::vector<real>& h, const std::vecto
     B[2 * M + n] = fixed[p + c] ? kPenalty * kdiag_[p + c] : h[2 * p + c];
     B[3 * M + n] = fixed[2 * p + c] ? kPenalty * kdiag_[2 * p + c] : 0;
   }
-  if (dmg_) {
-    S_.comm().sum(B.data(), int(B.size()));
-    dmg_->set_bottom_block(B);
-  } else {
-    mg_->set_bottom_block(B);
-  }
+  S_.comm().sum(B.data(), int(B.size()));
+  mg_->set_bottom_block(B);
   free_ = free_mask;
 }
 
@@ -56,10 +48,7 @@ void BoundaryPreconditioner::apply(const real* r, real* z) const {
   // full_in_ is zero off the contact nodes (set once; the scatter writes only
   // contact nodes and the V-cycle never writes its right-hand side)
   S_.scatter(r, full_in_.data());
-  if (dmg_)
-    dmg_->apply(full_in_.data(), full_out_.data());
-  else
-    mg_->apply(full_in_.data(), full_out_.data());
+  mg_->apply(full_in_.data(), full_out_.data());
   S_.gather(full_out_.data(), z);
   for (index i = 0; i < size(); ++i)
     if (!free_[i]) z[i] = 0;

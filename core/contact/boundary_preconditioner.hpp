@@ -13,18 +13,18 @@
 // Cost per apply: one fine V-cycle (about one inner CG iteration), i.e. about
 // a tenth of one S application.
 //
-// Several ranks (S.distributed()): the V-cycle is DistributedMultigrid's;
-// each rank fills B at its contact nodes and one allreduce of the plane
-// (4 nx ny values per Newton step) gives every rank the whole of it.
+// The V-cycle runs on the K_ii solver's hierarchy (grids, transfers, row
+// fetches, smoother bounds), shared. Several ranks: each rank fills B at
+// its contact nodes and one allreduce of the plane (4 nx ny values per
+// Newton step) gives every rank the whole of it.
 #pragma once
 #include <cstdint>
 #include <vector>
 
 #include <memory>
 
-#include "core/solvers/multigrid.hpp"
+#include "core/multigrid/multigrid.hpp"
 #include "core/contact/steklov.hpp"
-#include "core/parallel/distributed_multigrid.hpp"
 
 namespace tresca {
 
@@ -38,15 +38,14 @@ class BoundaryPreconditioner : public LinearOperator {
   // on sliding nodes), `fixed` (3p bytes, 1 where the increment is known)
   // and `free` mask (3p bytes) of the reduced system.
   // work of one apply in fine-grid matvec equivalents (one V-cycle of K + B)
-  double apply_work() const { return dmg_ ? dmg_->cycle_work() : mg_->cycle_work(); }
+  double apply_work() const { return mg_->cycle_work(); }
 
   void update(const std::vector<real>& h, const std::vector<std::uint8_t>& fixed,
               const std::vector<std::uint8_t>& free_mask);
 
  private:
   const SteklovPoincare& S_;
-  std::unique_ptr<Multigrid> mg_;             // one rank
-  std::unique_ptr<DistributedMultigrid> dmg_;  // several
+  std::unique_ptr<Multigrid> mg_;  // K + B
   std::vector<real> kdiag_;  // diag of K at this rank's contact nodes (3 blocks)
   std::vector<std::uint8_t> free_;
   mutable std::vector<real> full_in_, full_out_;

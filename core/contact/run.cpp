@@ -6,7 +6,7 @@
 
 #include "core/contact/nested.hpp"
 #include "core/parallel/comm.hpp"
-#include "core/parallel/distributed_multigrid.hpp"
+#include "core/multigrid/multigrid.hpp"
 #include "core/parallel/row_fetch.hpp"
 #include "kernels/contact_maps.hpp"
 #include "kernels/transfer.hpp"
@@ -103,7 +103,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   if (opt.phase_done) opt.phase_done("setup (mesh, operators, multigrid)", t1 - t0s);
   if (opt.iterate_done) {
     // each iterate's body: E u from one S apply, plus K_ii^{-1} l_i
-    const Slab rows = S.distributed() ? S.slab() : make_slab(R.problem->grid, 0, 1);
+    const Slab rows = S.slab();
     newton.progress = [&, rows, shown = newton.progress, step = 0](const NewtonProgress& pr) mutable {
       if (shown) shown(pr);
       std::vector<real> r(pr.u->size()), u_full(S.full_size());
@@ -260,7 +260,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.report.status = S.whole(R.report.status);
   }
   R.contact = std::move(law);
-  R.slab = S.distributed() ? S.slab() : make_slab(R.problem->grid, 0, 1);
+  R.slab = S.slab();
   if (opt.recover_interior) {
     R.u_full = std::move(body);
     S.exchange_ghosts(R.u_full.data());  // its ghost rows too (output pieces)

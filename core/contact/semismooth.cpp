@@ -228,7 +228,7 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
   // like target/|r_j| as the outer residual r_j falls
   co.on_residual = [&](real rn) { A.set_inner_rtol(std::clamp(target / rn, real(1e-12), inner_max)); };
   co.abort_if = [&] { return work.failures > fails0; };  // an S apply is untrustworthy
-  co.comm = S.distributed() ? &S.comm() : nullptr;      // contact vectors over the ranks
+  co.reduction = &S.comm();  // contact vectors over the ranks (Comm::self() when not split)
   if (L.coupled) {
     // not symmetric: GMRES with the same preconditioner. The inner accuracy
     // is fixed at 0.3 eta (0.1: 2-9 % more work, 1: a fifth Newton step at
@@ -242,7 +242,7 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
     go.max_iterations = co.max_iterations;
     A.set_inner_rtol(std::clamp(0.3 * eta, real(1e-12), inner_max));
     go.abort_if = co.abort_if;
-    go.comm = co.comm;
+    go.reduction = co.reduction;
     ScopedTimer t(Kernel::outer_cg);
     out.outer = gmres(A, M, L.rhs.data(), du.data(), go);
     std::fill(side.begin(), side.end(), 0.0);

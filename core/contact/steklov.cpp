@@ -1,38 +1,29 @@
 #include "core/contact/steklov.hpp"
 
-#include "core/parallel/distributed_elasticity.hpp"
-
 #include <stdexcept>
 #include <string>
 
 #include "kernels/vector_ops.hpp"
-#include "core/parallel/distributed_multigrid.hpp"
 #include "core/util/profile.hpp"
 
 namespace tresca {
 
 SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Comm& comm)
-    : P_(P), p_(P.contact_nodes()), comm_(comm), mg_opt_(mg) {
-  if (worth_distributing(P.grid, comm)) {
-    dmg_ = std::make_unique<DistributedMultigrid>(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mg, comm);
-    Kd_ = std::make_unique<DistributedElasticity>(dmg_->fine_slab(), P.dirichlet_faces, P.spec.E, P.spec.nu, comm);
-    // contact node c = (ix - 1) + ex iy: a rank's rows hold a contiguous range
-    const index ex = P.grid.ex;
-    c_begin_ = ex * dmg_->fine_slab().y_begin;
-    c_end_ = ex * dmg_->fine_slab().y_end;
-    p_ = c_end_ - c_begin_;  // contact vectors hold this rank's nodes
-    counts_.resize(comm.size());
-    displs_.resize(comm.size());
-    for (int q = 0; q < comm.size(); ++q) {
-      const Slab s = make_slab(P.grid, q, comm.size());
-      counts_[q] = int(ex * s.owned_rows());
-      displs_[q] = int(ex * s.y_begin);
-    }
-  } else {
-    c_end_ = p_;
-    K_ = ElasticityOperator(P.grid, P.dirichlet_faces, P.spec.E, P.spec.nu);
-    mg_ = std::make_unique<Multigrid>(GridHierarchy::build(P.grid, mg.coarse_nodes),
-                                      elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mg);
+    : P_(P), p_(P.contact_nodes()), comm_(worth_distributing(P.grid, comm) ? comm : Comm::self()), mg_opt_(mg) {
+  const auto grids = GridHierarchy::build(P.grid, mg.coarse_nodes, comm_);
+  K_ = ElasticityOperator(grids->levels[0].slab, P.dirichlet_faces, P.spec.E, P.spec.nu);
+  mg_ = std::make_unique<Multigrid>(grids, elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mg);
+  // contact node c = (ix - 1) + ex iy: a rank's rows hold a contiguous range
+  const index ex = P.grid.ex;
+  c_begin_ = ex * slab().y_begin;
+  c_end_ = ex * slab().y_end;
+  p_ = c_end_ - c_begin_;  // contact vectors hold this rank's nodes
+  counts_.resize(comm_.size());
+  displs_.resize(comm_.size());
+  for (int q = 0; q < comm_.size(); ++q) {
+    const Slab s = make_slab(P.grid, q, comm_.size());
+    counts_[q] = int(ex * s.owned_rows());
+    displs_[q] = int(ex * s.y_begin);
   }
   const index n = full_size();
   w_.assign(n, 0);
@@ -42,17 +33,9 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
 
 SteklovPoincare::~SteklovPoincare() = default;
 
-index SteklovPoincare::full_size() const { return dmg_ ? 3 * dmg_->fine_slab().local.nodes() : 3 * P_.nodes(); }
-const Slab& SteklovPoincare::slab() const { return dmg_->fine_slab(); }
-void SteklovPoincare::exchange_ghosts(real* full) const {
-  if (Kd_) Kd_->exchange(full);
-}
-
-const GridDims& SteklovPoincare::box() const { return dmg_ ? dmg_->fine_slab().local : P_.grid; }
-
 void SteklovPoincare::scatter(const real* vc, real* full) const {
   const GridDims& g = box();
-  const index N = g.nodes(), ex = P_.grid.ex, row0 = dmg_ ? slab().y_begin - slab().lo : 0;
+  const index N = g.nodes(), ex = P_.grid.ex, row0 = slab().y_begin - slab().lo;
   for (index c = c_begin_; c < c_end_; ++c) {
     const index n = g.node(1 + c % ex, c / ex - row0, 0);
     for (int a = 0; a < 3; ++a) full[a * N + n] = vc[a * p_ + c - c_begin_];
@@ -61,15 +44,15 @@ void SteklovPoincare::scatter(const real* vc, real* full) const {
 
 void SteklovPoincare::gather(const real* full, real* vc) const {
   const GridDims& g = box();
-  const index N = g.nodes(), ex = P_.grid.ex, row0 = dmg_ ? slab().y_begin - slab().lo : 0;
+  const index N = g.nodes(), ex = P_.grid.ex, row0 = slab().y_begin - slab().lo;
   for (index c = c_begin_; c < c_end_; ++c) {
     const index n = g.node(1 + c % ex, c / ex - row0, 0);
     for (int a = 0; a < 3; ++a) vc[a * p_ + c - c_begin_] = full[a * N + n];
   }
 }
 
-real SteklovPoincare::sum(real local) const { return dmg_ ? comm_.sum(local) : local; }
-real SteklovPoincare::max(real local) const { return dmg_ ? real(comm_.max(local)) : local; }
+real SteklovPoincare::sum(real local) const { return comm_.sum(local); }
+real SteklovPoincare::max(real local) const { return real(comm_.max(local)); }
 
 std::vector<real> SteklovPoincare::local_part(const std::vector<real>& whole, int blocks) const {
   const index pg = P_.contact_nodes();
@@ -82,7 +65,7 @@ std::vector<real> SteklovPoincare::local_part(const std::vector<real>& whole, in
 }
 
 std::vector<real> SteklovPoincare::whole(const std::vector<real>& local, int blocks) const {
-  if (!dmg_ || local.empty()) return local;  // (empty: nothing to gather, e.g. a failed run's S u)
+  if (!distributed() || local.empty()) return local;  // (empty: nothing to gather, e.g. a failed run's S u)
   if (index(local.size()) != blocks * p_)
     throw std::invalid_argument("SteklovPoincare::whole: " + std::to_string(local.size()) + " values, expected " +
                                 std::to_string(blocks * p_));
@@ -96,44 +79,36 @@ std::vector<real> SteklovPoincare::whole(const std::vector<real>& local, int blo
 }
 
 std::vector<std::uint8_t> SteklovPoincare::whole(const std::vector<std::uint8_t>& local) const {
-  if (!dmg_ || local.empty()) return local;
+  if (!distributed() || local.empty()) return local;
   const std::vector<real> w = whole(std::vector<real>(local.begin(), local.end()), 1);
   return std::vector<std::uint8_t>(w.begin(), w.end());
 }
 
 std::vector<real> SteklovPoincare::contact_diagonal() const {
-  std::vector<real> d(full_size()), dc(3 * p_);
-  if (Kd_)
-    Kd_->diagonal(d.data());
-  else
-    d = K_.diagonal();
+  const std::vector<real> d = K_.diagonal();
+  std::vector<real> dc(3 * p_);
   gather(d.data(), dc.data());
   return dc;
 }
 
-void SteklovPoincare::apply_planes(const real* x, real* y, index z_begin, index z_end) const {
-  if (Kd_)
-    Kd_->apply_planes(x, y, z_begin, z_end);
-  else
-    K_.apply_planes(x, y, z_begin, z_end);
+void SteklovPoincare::apply_planes(real* x, real* y, index z_begin, index z_end) const {
+  K_.update_ghosts(x);
+  K_.apply_planes(x, y, z_begin, z_end);
 }
 
 SolveStats SteklovPoincare::solve_interior(const real* rhs, real* z, real rtol, const real* guess) const {
   ScopedTimer t(Kernel::inner_cg);
   CGOptions o;
   o.rtol = rtol;
-  const unsigned faces = dmg_ ? slab().local_faces(P_.interior_faces) : P_.interior_faces;
+  const ElasticityOperator& Kii = mg_->op(0);
   if (guess) {
     copy(full_size(), guess, z);
-    zero_constrained(box(), faces, z);  // the guess of an extension carries v on plane 0
+    zero_constrained(box(), Kii.faces(), z);  // the guess of an extension carries v on plane 0
     o.zero_initial_guess = false;
   }
   o.max_iterations = 500;
-  if (dmg_) {
-    o.comm = &comm_;
-    return pcg(dmg_->op(), dmg_.get(), rhs, z, o, ws_);
-  }
-  return pcg(mg_->op(0), mg_.get(), rhs, z, o, ws_);
+  o.reduction = &comm_;
+  return pcg(Kii, mg_.get(), rhs, z, o, ws_);
 }
 
 void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
@@ -155,17 +130,12 @@ SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* exte
 SolveStats SteklovPoincare::residual(const real* u, real* r, real rtol, real* body, const real* guess) const {
   // the load on this rank's rows (all of it on one rank); its interior part
   // is the solve's right-hand side besides -K_ic u
-  std::vector<real> load;
-  if (dmg_) {
-    load.assign(full_size(), 0);
-    global_to_local(slab(), P_.load.data(), load.data());
-  } else {
-    load = P_.load;
-  }
+  std::vector<real> load(full_size());
+  global_to_local(slab(), P_.load.data(), load.data());
   std::vector<real> lc(3 * p_);
   gather(load.data(), lc.data());
-  zero_constrained(box(), dmg_ ? slab().local_faces(P_.interior_faces) : P_.interior_faces, load.data());
-  if (dmg_) Kd_->zero_ghosts(load.data());
+  zero_constrained(box(), mg_->op(0).faces(), load.data());
+  K_.zero_ghosts(load.data());
   const SolveStats st = extend(u, load.data(), r, rtol, body, guess);
   for (index i = 0; i < 3 * p_; ++i) r[i] -= lc[i];
   return st;
@@ -196,8 +166,7 @@ SolveStats SteklovPoincare::extend(const real* v, real* li, real* out, real rtol
 }
 
 double SteklovPoincare::apply_work(long long inner_iterations) const {
-  const double cycle = dmg_ ? dmg_->cycle_work() : mg_->cycle_work();
-  return double(inner_iterations) * (1 + cycle) + 2.0 / double(P_.grid.nz());
+  return double(inner_iterations) * (1 + mg_->cycle_work()) + 2.0 / double(P_.grid.nz());
 }
 
 SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior,

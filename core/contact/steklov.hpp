@@ -15,15 +15,15 @@
 // [u_x(0..p-1) | u_y | u_z], contact node c as in problem.hpp.
 // Cost per apply: one inner MG-CG solve (dominant) + 2 plane applies.
 //
-// Ranks (core/parallel): when the run has several MPI ranks and the grid is
-// worth splitting (worth_distributing), the 3D vectors are y-slab local
-// vectors (slab.hpp; full_size() entries), K and the K_ii multigrid are
-// distributed, and so are the contact vectors: a rank's contact nodes are
-// those of its rows, c in [first_contact_node(), + contact_nodes()), and
-// its contact vectors hold just those (3 blocks of contact_nodes()). Sums
-// and maxima over contact vectors go through sum() and max(); local_part
-// and whole convert from and to vectors of every contact node. One rank:
-// the threaded code, bit for bit.
+// Ranks: when the run has several MPI ranks and the grid is worth splitting
+// (worth_distributing), the 3D vectors are y-slab local vectors (slab.hpp;
+// full_size() entries), K and the K_ii multigrid are split, and so are the
+// contact vectors: a rank's contact nodes are those of its rows, c in
+// [first_contact_node(), + contact_nodes()), and its contact vectors hold
+// just those (3 blocks of contact_nodes()). Sums and maxima over contact
+// vectors go through sum() and max(); local_part and whole convert from and
+// to vectors of every contact node. Otherwise every rank holds the whole
+// problem (comm() is Comm::self()): one slab, the same code, no messages.
 //
 // State: the operator is immutable after construction. Every call takes the
 // inner solve's relative tolerance and returns that solve's SolveStats (the
@@ -36,15 +36,11 @@
 #include <memory>
 
 #include "core/solvers/cg.hpp"
-#include "core/solvers/multigrid.hpp"
+#include "core/multigrid/multigrid.hpp"
 #include "core/fem/problem.hpp"
 #include "core/parallel/comm.hpp"
 
 namespace tresca {
-
-class DistributedElasticity;
-class DistributedMultigrid;
-struct Slab;
 
 class SteklovPoincare {
  public:
@@ -63,12 +59,13 @@ class SteklovPoincare {
   std::vector<std::uint8_t> whole(const std::vector<std::uint8_t>& local) const;
   // entries of a 3D vector (extension, guess, interior): 3N, or 3 x the
   // rank's slab nodes when distributed
-  index full_size() const;
-  bool distributed() const { return bool(dmg_); }
-  const Slab& slab() const;  // distributed only
-  // the ghost rows of a 3D vector := the neighbours' values (distributed; else nothing)
-  void exchange_ghosts(real* full) const;
-  const DistributedMultigrid& distributed_multigrid() const { return *dmg_; }  // distributed only
+  index full_size() const { return K_.size(); }
+  bool distributed() const { return K_.distributed(); }
+  // this rank's slab of the grid (the whole grid when not split)
+  const Slab& slab() const { return K_.slab(); }
+  // the ghost rows of a 3D vector := the neighbours' values (nothing when not split)
+  void exchange_ghosts(real* full) const { K_.update_ghosts(full); }
+  // the ranks the vectors are split over (Comm::self() when not split)
   const Comm& comm() const { return comm_; }
   const MGOptions& mg_options() const { return mg_opt_; }
   // diag(K) at the contact nodes, 3 blocks of p (K clamped on x = 0 only)
@@ -94,7 +91,8 @@ class SteklovPoincare {
   SolveStats condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior = nullptr,
                             const real* guess = nullptr) const;
 
-  const Multigrid& interior_multigrid() const { return *mg_; }  // one rank only
+  // the K_ii multigrid; its hierarchy() is shared with the Newton step's preconditioner
+  const Multigrid& interior_multigrid() const { return *mg_; }
   // work of one apply in fine-grid matvec equivalents, given the inner CG
   // iterations it took: each iteration one K_ii apply and one V-cycle, plus
   // the two plane applies around the solve
@@ -114,20 +112,17 @@ class SteklovPoincare {
   SolveStats extend(const real* v, real* li, real* out, real rtol, real* extension, const real* guess) const;
   // plane iz of all 3 components of v := src's (or 0 if src is null)
   void set_plane(real* v, index iz, const real* src) const;
-  void apply_planes(const real* x, real* y, index z_begin, index z_end) const;
-  const GridDims& box() const;  // the grid of the 3D vectors
+  // y = K x on planes [z_begin, z_end), x's ghost rows updated first
+  void apply_planes(real* x, real* y, index z_begin, index z_end) const;
+  const GridDims& box() const { return slab().local; }  // the grid of the 3D vectors
 
   const Problem& P_;
   index p_;
   const Comm& comm_;
   MGOptions mg_opt_;
-  // one rank
-  ElasticityOperator K_;       // faces x0
-  std::unique_ptr<Multigrid> mg_;  // K_ii hierarchy, faces x0 | z0
-  // several ranks (empty otherwise)
-  std::unique_ptr<DistributedElasticity> Kd_;  // faces x0
-  std::unique_ptr<DistributedMultigrid> dmg_;  // K_ii, faces x0 | z0
-  index c_begin_ = 0, c_end_ = 0;              // this rank's contact nodes
+  ElasticityOperator K_;           // faces x0
+  std::unique_ptr<Multigrid> mg_;  // K_ii, faces x0 | z0
+  index c_begin_ = 0, c_end_ = 0;  // this rank's contact nodes
   std::vector<int> counts_, displs_;           // every rank's contact nodes (whole())
   mutable CGWorkspace ws_;  // scratch
   mutable std::vector<real> w_, t_, z_;

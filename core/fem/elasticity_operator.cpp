@@ -1,65 +1,103 @@
 #include "core/fem/elasticity_operator.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "kernels/boundary_block.hpp"
+#include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
 
 namespace tresca {
 
 ElasticityOperator::ElasticityOperator(const GridDims& g, unsigned faces, real E, real nu)
-    : k_(build_elasticity_stencil(g, faces, E, nu)) {}
+    : ElasticityOperator(make_slab(g, 0, 1), faces, E, nu) {}
 
-void ElasticityOperator::apply(const real* x, real* y) const { apply_planes(x, y, 0, k_.g.nz()); }
+ElasticityOperator::ElasticityOperator(const Slab& s, unsigned faces, real E, real nu)
+    : slab_(s),
+      global_faces_(faces),
+      halo_(s),
+      // the global grid's spacing: a slab's ly/ey may round in the last bit (slab.hpp)
+      k_(build_elasticity_stencil(s.local, s.local_faces(faces), E, nu, {s.global.hx(), s.global.hy(), s.global.hz()})),
+      kf_(stencil_in_precision<float>(k_)) {}
+
+template <>
+const ElasticityStencilT<double>& ElasticityOperator::stencil_in<double>() const {
+  return k_;
+}
+template <>
+const ElasticityStencilT<float>& ElasticityOperator::stencil_in<float>() const {
+  return kf_;
+}
+template <>
+const std::vector<double>& ElasticityOperator::block_in<double>() const {
+  return B_;
+}
+template <>
+const std::vector<float>& ElasticityOperator::block_in<float>() const {
+  return Bf_;
+}
+
+template <class T>
+void ElasticityOperator::apply_rows(const T* x, T* y, const T* b, index z_begin, index z_end) const {
+  const GridDims& g = slab_.local;
+  const index first = slab_.lo, last = slab_.lo + slab_.owned_rows();  // owned local rows
+  {
+    const double nodes = double(g.nx()) * double(last - first) * double(z_end - z_begin);
+    ScopedTimer t(Kernel::apply, nodes * in_precision<T>(b ? kResidualCost : kApplyCost));
+    elasticity_apply<T>(stencil_in<T>(), x, y, RowBlock{z_begin, z_end, first, last}, b);
+  }
+  const std::vector<T>& B = block_in<T>();
+  if (!B.empty() && z_begin == 0 && z_end > 0) {  // B is 0 on ghost rows
+    const double m = double(g.nx()) * double(g.ny());
+    ScopedTimer t(Kernel::apply_boundary, m * in_precision<T>(kBottomBlockCost));
+    bottom_block_apply<T>(g, T(b ? -1 : 1), B.data(), x, y);
+  }
+  if (z_begin == 0 && z_end == g.nz()) halo_.zero_ghosts(y);
+}
+
+template void ElasticityOperator::apply_rows<double>(const double*, double*, const double*, index, index) const;
+template void ElasticityOperator::apply_rows<float>(const float*, float*, const float*, index, index) const;
 
 void ElasticityOperator::apply_planes(const real* x, real* y, index z_begin, index z_end) const {
-  const GridDims& g = k_.g;
-  {
-    const double nodes = double(g.nx()) * double(g.ny()) * double(z_end - z_begin);
-    ScopedTimer t(Kernel::apply, nodes * kApplyCost);
-    elasticity_apply(k_, x, y, z_begin, z_end);
-  }
-  if (!B_.empty() && z_begin == 0 && z_end > 0) {
-    const double m = double(g.nx()) * double(g.ny());
-    ScopedTimer t(Kernel::apply_boundary, m * kBottomBlockCost);
-    bottom_block_apply<real>(g, 1, B_.data(), x, y);
-  }
+  apply_rows<real>(x, y, nullptr, z_begin, z_end);
 }
 
-void ElasticityOperator::residual(const real* b, const real* x, real* r) const {
-  const GridDims& g = k_.g;
-  {
-    const double nodes = double(g.nodes());
-    ScopedTimer t(Kernel::apply, nodes * kResidualCost);
-    elasticity_apply(k_, x, r, 0, g.nz(), b);
-  }
-  if (!B_.empty()) {
-    const double m = double(g.nx()) * double(g.ny());
-    ScopedTimer t(Kernel::apply_boundary, m * kBottomBlockCost);
-    bottom_block_apply<real>(g, -1, B_.data(), x, r);
-  }
-}
-
-void ElasticityOperator::set_bottom_block(std::vector<real> B) {
-  const GridDims& g = k_.g;
-  if (!B.empty() && index(B.size()) != 4 * g.nx() * g.ny())
+void ElasticityOperator::set_bottom_block(const std::vector<real>& B) {
+  const GridDims& G = slab_.global;
+  const index M = G.nx() * G.ny();
+  if (!B.empty() && index(B.size()) != 4 * M)
     throw std::invalid_argument("bottom block has " + std::to_string(B.size()) + " entries, expected 4 x " +
-                                std::to_string(g.nx() * g.ny()));
-  B_ = std::move(B);
-  if (B_.empty()) return;
+                                std::to_string(M));
+  B_.clear();
+  Bf_.clear();
+  if (B.empty()) return;
+  std::vector<real> Bz = B;
+  zero_constrained_bottom_block(G, global_faces_, Bz);
+  const GridDims& g = slab_.local;
+  const index Ml = g.nx() * g.ny(), row0 = slab_.y_begin - slab_.lo;
+  B_.assign(4 * Ml, 0.0);
+  for (int f = 0; f < 4; ++f)  // owned rows only: ghost rows stay 0
+    std::copy_n(Bz.data() + f * M + G.nx() * slab_.y_begin, G.nx() * slab_.owned_rows(),
+                B_.data() + f * Ml + g.nx() * (slab_.y_begin - row0));
+  Bf_.assign(B_.begin(), B_.end());
+}
+
+void zero_constrained_bottom_block(const GridDims& g, unsigned faces, std::vector<real>& B) {
+  if (B.empty()) return;
   const index M = g.nx() * g.ny();
   for (index iy = 0; iy < g.ny(); ++iy)
     for (index ix = 0; ix < g.nx(); ++ix)
-      if (node_constrained(g, k_.faces, ix, iy, 0))
-        for (int f = 0; f < 4; ++f) B_[f * M + ix + g.nx() * iy] = 0;
+      if (node_constrained(g, faces, ix, iy, 0))
+        for (int f = 0; f < 4; ++f) B[f * M + ix + g.nx() * iy] = 0;
 }
 
 std::vector<real> ElasticityOperator::diagonal() const {
   std::vector<real> d(size());
   elasticity_diagonal(k_, d.data());
   if (!B_.empty()) {
-    const GridDims& g = k_.g;
+    const GridDims& g = slab_.local;
     const index M = g.nx() * g.ny(), N = g.nodes();
     for (index n = 0; n < M; ++n) {
       d[n] += B_[n];
@@ -67,7 +105,14 @@ std::vector<real> ElasticityOperator::diagonal() const {
       d[2 * N + n] += B_[3 * M + n];
     }
   }
+  halo_.zero_ghosts(d.data());
   return d;
 }
+
+JacobiPreconditioner::JacobiPreconditioner(const ElasticityOperator& K) : inv_(K.diagonal()) {
+  for (real& v : inv_) v = v != 0 ? 1 / v : 0;
+}
+
+void JacobiPreconditioner::apply(const real* r, real* z) const { hadamard(size(), inv_.data(), r, z); }
 
 }  // namespace tresca

@@ -1,43 +1,107 @@
-// The stiffness operator of one grid as a LinearOperator (see
-// kernels/elasticity.hpp for what is computed and the data layout), with an
-// optional block term B on the bottom face (kernels/boundary_block.hpp):
+// The stiffness operator K of a grid, or of one rank's slab of it, as a
+// LinearOperator (kernels/elasticity.hpp: what is computed and the data
+// layout), with an optional block term B on the bottom face
+// (kernels/boundary_block.hpp):
 //
 //   y = (K + B) x   on free dofs,   y = x on constrained dofs.
+//
+// One operator for one rank and many: its vectors live on a slab's local
+// box (core/parallel/slab.hpp), the owned node rows and one ghost row per
+// neighbouring rank. apply and residual write the owned rows, zero the
+// ghost rows, and read x's ghost rows as they are; update_ghosts(x) makes
+// them current (the halo exchange, core/parallel/halo.hpp). The whole grid
+// is the slab of one rank: no ghost rows, nothing sent, the same kernels.
+// Sums over a vector's entries count every global entry once (ghost rows
+// of outputs are 0), so dots need only the ranks' sum.
+//
+// Precision: double, and single for the multigrid V-cycle's levels (the
+// coefficients and B rounded to float; messages of floats).
 #pragma once
 #include <vector>
 
-#include "kernels/elasticity.hpp"
+#include "core/parallel/halo.hpp"
+#include "core/parallel/slab.hpp"
 #include "core/solvers/operator.hpp"
+#include "kernels/elasticity.hpp"
 
 namespace tresca {
 
 class ElasticityOperator : public LinearOperator {
  public:
   ElasticityOperator() = default;
+  // the whole grid g with constrained faces
   ElasticityOperator(const GridDims& g, unsigned faces, real E, real nu);
+  // rank's slab s of the grid s.global, whose constrained faces are `faces`
+  ElasticityOperator(const Slab& s, unsigned faces, real E, real nu);
 
-  index size() const override { return k_.size(); }
-  void apply(const real* x, real* y) const override;
-  // y = (K + B) x on output planes [z_begin, z_end) only
+  index size() const override { return 3 * slab_.local.nodes(); }
+  void apply(const real* x, real* y) const override { apply_rows<real>(x, y, nullptr, 0, slab_.local.nz()); }
+  void apply(const float* x, float* y) const { apply_rows<float>(x, y, nullptr, 0, slab_.local.nz()); }
+  // y = (K + B) x on output planes [z_begin, z_end) of the owned rows;
+  // other entries of y untouched
   void apply_planes(const real* x, real* y, index z_begin, index z_end) const;
   // r = b - (K + B) x, fused into the apply (no separate vector pass)
-  void residual(const real* b, const real* x, real* r) const;
+  void residual(const real* b, const real* x, real* r) const { apply_rows<real>(x, r, b, 0, slab_.local.nz()); }
+  void residual(const float* b, const float* x, float* r) const { apply_rows<float>(x, r, b, 0, slab_.local.nz()); }
+  void update_ghosts(real* x) const override { halo_.exchange(x); }
+  void update_ghosts(float* x) const { halo_.exchange(x); }
+  template <class T>
+  void zero_ghosts(T* v) const {
+    halo_.zero_ghosts(v);
+  }
 
-  const GridDims& grid() const { return k_.g; }
+  // the local box of the vectors (the whole grid on one rank)
+  const GridDims& grid() const { return slab_.local; }
+  const Slab& slab() const { return slab_; }
+  bool distributed() const { return !halo_.empty(); }
+  // constrained faces of the local box, and of the global grid
   unsigned faces() const { return k_.faces; }
+  unsigned global_faces() const { return global_faces_; }
   const ElasticityStencil& stencil() const { return k_; }
+  const HaloCounts& halo_counts() const { return halo_.counts(); }
 
-  // B: 4 fields of nx*ny (bxx, bxy, byy, bzz); empty vector removes the term.
-  // Entries on constrained nodes are ignored (set to zero).
-  void set_bottom_block(std::vector<real> B);
+  // B over the whole bottom plane of the global grid: 4 fields of nx*ny
+  // (bxx, bxy, byy, bzz); the operator keeps its owned rows. Entries on
+  // constrained nodes are ignored (set to zero); empty removes the term.
+  void set_bottom_block(const std::vector<real>& B);
+  // B on the local box's bottom plane (ghost rows 0); empty: none
   const std::vector<real>& bottom_block() const { return B_; }
 
-  // diag(K + B), 1 on constrained dofs
+  // diag(K + B) on the owned rows, 1 on constrained dofs, 0 on ghost rows
   std::vector<real> diagonal() const;
 
  private:
+  template <class T>
+  const ElasticityStencilT<T>& stencil_in() const;
+  template <class T>
+  const std::vector<T>& block_in() const;
+  // y = (K + B) x (or b - (K + B) x) on planes [z_begin, z_end) of the owned rows
+  template <class T>
+  void apply_rows(const T* x, T* y, const T* b, index z_begin, index z_end) const;
+
+  Slab slab_;
+  unsigned global_faces_ = 0;
+  Halo halo_;
   ElasticityStencil k_;
+  ElasticityStencilT<float> kf_;
   std::vector<real> B_;
+  std::vector<float> Bf_;
+};
+
+// B (4 fields over the bottom plane of grid g) := 0 on the nodes of the
+// constrained faces; empty: nothing
+void zero_constrained_bottom_block(const GridDims& g, unsigned faces, std::vector<real>& B);
+
+// z = D^{-1} r with D = diag(K + B) (Jacobi; 0 on ghost rows): a simple CG
+// preconditioner (the elastic driver's --pc jacobi, tests)
+class JacobiPreconditioner : public LinearOperator {
+ public:
+  explicit JacobiPreconditioner(const ElasticityOperator& K);
+  index size() const override { return index(inv_.size()); }
+  void apply(const real* r, real* z) const override;
+
+ private:
+  std::vector<real> inv_;
 };
 
 }  // namespace tresca

@@ -19,6 +19,10 @@ Comm& world_instance() {
 }  // namespace
 
 const Comm& Comm::world() { return world_instance(); }
+const Comm& Comm::self() {
+  static const Comm c;
+  return c;
+}
 
 CommCounters& comm_counters() {
   static CommCounters c;

@@ -10,18 +10,22 @@
 #pragma once
 #include <vector>
 
+#include "core/util/reduction.hpp"
 #include "kernels/types.hpp"
 
 namespace tresca {
 
-class Comm {
+class Comm : public Reduction {
  public:
   // the world of this process: MPI_COMM_WORLD if MPI is initialised, else one rank
   static const Comm& world();
+  // this rank alone (size 1, nothing is ever sent): the whole problem on
+  // every rank, e.g. a grid too small to split
+  static const Comm& self();
   int rank() const { return rank_; }
   int size() const { return size_; }
   bool distributed() const { return size_ > 1; }
-  real sum(real local) const;
+  real sum(real local) const override;
   void sum(real* values, int n) const;  // in place, element by element
   double max(double local) const;
   // in place: rank q's part v[displs[q] .. displs[q] + counts[q]) to every rank

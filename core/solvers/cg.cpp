@@ -5,7 +5,6 @@
 #include <string>
 
 #include "kernels/vector_ops.hpp"
-#include "core/parallel/comm.hpp"
 #include "core/util/profile.hpp"
 
 namespace tresca {
@@ -40,9 +39,10 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
   real *r = ws.r.data(), *z = ws.z.data(), *p = ws.p.data(), *q = ws.q.data(), *sp = ws.s.data();
   SolveStats st;
   // local sums -> the sum over all ranks (identity on one rank)
-  auto global = [&](real local) { return opt.comm ? opt.comm->sum(local) : local; };
-  auto apply = [&](const real* in, real* out) {
+  auto global = [&](real local) { return opt.reduction ? opt.reduction->sum(local) : local; };
+  auto apply = [&](real* in, real* out) {
     st.operator_applications += 1;
+    A.update_ghosts(in);
     if (side)
       side->apply(in, out, sp);
     else

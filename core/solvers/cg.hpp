@@ -15,10 +15,9 @@
 #include <vector>
 
 #include "core/solvers/operator.hpp"
+#include "core/util/reduction.hpp"
 
 namespace tresca {
-
-class Comm;
 
 enum class SolveReason { converged, max_iterations, breakdown, non_finite, aborted };
 const char* to_string(SolveReason r);
@@ -44,9 +43,10 @@ struct CGOptions {
   std::function<void(real rnorm)> on_residual;
   // checked after every application of A; true stops with reason aborted
   std::function<bool()> abort_if;
-  // the ranks over which the vectors are distributed (core/parallel/comm.hpp):
-  // every dot product is the sum of the ranks' local ones. Null: one rank.
-  const Comm* comm = nullptr;
+  // the parts over which the vectors are distributed (the ranks of a run,
+  // core/util/reduction.hpp): every dot product is the sum of the parts'
+  // local ones. Null: one part.
+  const Reduction* reduction = nullptr;
 };
 
 // Work vectors kept by the caller so repeated solves do not allocate.

@@ -5,7 +5,6 @@
 #include <string>
 
 #include "kernels/vector_ops.hpp"
-#include "core/parallel/comm.hpp"
 
 namespace tresca {
 
@@ -23,7 +22,7 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
 
   SolveStats st;
   // local sums -> over all ranks (identity on one rank)
-  auto norm = [&](const real* v) { return std::sqrt(opt.comm ? opt.comm->sum(dot(n, v, v)) : dot(n, v, v)); };
+  auto norm = [&](const real* v) { return std::sqrt(opt.reduction ? opt.reduction->sum(dot(n, v, v)) : dot(n, v, v)); };
   st.rhs_norm = norm(b);
   const real target = std::max(opt.rtol * st.rhs_norm, opt.atol);
   if (opt.zero_initial_guess) fill<real>(n, 0, x);
@@ -34,6 +33,7 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
     if (first && opt.zero_initial_guess) {
       copy(n, b, r);
     } else {
+      A.update_ghosts(x);
       A.apply(x, w.data());
       st.operator_applications += 1;
       copy(n, b, r);
@@ -65,6 +65,7 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
       } else {
         copy(n, V[j].data(), Z[j].data());
       }
+      A.update_ghosts(Z[j].data());
       A.apply(Z[j].data(), w.data());
       st.operator_applications += 1;
       st.iterations += 1;
@@ -74,7 +75,7 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
       }
       for (int i = 0; i <= j; ++i) {
         h(i, j) = dot(n, w.data(), V[i].data());
-        if (opt.comm) h(i, j) = opt.comm->sum(h(i, j));
+        if (opt.reduction) h(i, j) = opt.reduction->sum(h(i, j));
         axpy(n, -h(i, j), V[i].data(), w.data());
       }
       const real hn = norm(w.data());  // ||w||: the next basis vector is w / hn
@@ -120,6 +121,7 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
     for (int i = 0; i < j; ++i) axpy(n, y[i], Z[i].data(), x);
     if (invariant && st.residual > target) {
       // the space is exhausted: the recomputed residual decides
+      A.update_ghosts(x);
       A.apply(x, w.data());
       st.operator_applications += 1;
       copy(n, b, r);

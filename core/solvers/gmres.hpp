@@ -22,8 +22,6 @@
 
 namespace tresca {
 
-class Comm;
-
 struct GMRESOptions {
   real rtol = 1e-10;
   real atol = 0;
@@ -33,8 +31,8 @@ struct GMRESOptions {
   // polled after each application of A: true stops with `aborted` (e.g. an
   // inexact A whose own inner solve failed)
   std::function<bool()> abort_if;
-  // the ranks the vectors are distributed over (as CGOptions::comm); null: one rank
-  const Comm* comm = nullptr;
+  // the parts the vectors are distributed over (as CGOptions::reduction); null: one part
+  const Reduction* reduction = nullptr;
 };
 
 SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b, real* x, const GMRESOptions& opt);

@@ -1,5 +1,13 @@
 // What a solver sees: a square linear operator y = A x on vectors of size().
 // (MFEM Operator::Mult, Ginkgo LinOp.) Preconditioners are operators too.
+//
+// Ghost entries: an operator on a part of a distributed grid (a rank's
+// slab, core/fem/elasticity_operator.hpp) reads, besides the entries its
+// part owns, copies of a few of its neighbours' (ghost entries). apply()
+// reads them as they are; update_ghosts(x) makes them current (the halo
+// exchange, HPCG's ExchangeHalo), writing x's ghost entries and nothing
+// else. A solver calls it on its own vector before each apply; operators
+// without ghosts do nothing.
 #pragma once
 #include "kernels/types.hpp"
 
@@ -10,6 +18,7 @@ class LinearOperator {
   virtual ~LinearOperator() = default;
   virtual index size() const = 0;
   virtual void apply(const real* x, real* y) const = 0;
+  virtual void update_ghosts(real* x) const { (void)x; }
 };
 
 // An operator y = A x whose evaluation also yields s = B x for a second linear

@@ -1,4 +1,4 @@
-#include "core/solvers/smoothing.hpp"
+#include "core/multigrid/smoothing.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -6,10 +6,10 @@
 
 namespace tresca {
 
-real lanczos_lmax(index n, const std::function<void(const real*, real*)>& apply, const std::vector<real>& dinv,
-                  std::vector<real> r, const std::function<real(real)>& reduce) {
+real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const std::vector<real>& dinv,
+                  std::vector<real> r, const Reduction* reduce) {
   // Lanczos through Jacobi-PCG: T_jj = 1/a_j + b_{j-1}/a_{j-1}, T_j,j+1 = sqrt(b_j)/a_j
-  auto global = [&](real s) { return reduce ? reduce(s) : s; };
+  auto global = [&](real s) { return reduce ? reduce->sum(s) : s; };
   std::vector<real> x(n, 0), z(n), p(n), q(n);
   hadamard(n, dinv.data(), r.data(), z.data());
   copy(n, z.data(), p.data());

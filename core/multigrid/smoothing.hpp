@@ -1,12 +1,10 @@
-// The pieces of a multigrid V-cycle that do not depend on how a level is
-// stored: shared by Multigrid (multigrid.hpp, one rank) and
-// DistributedMultigrid (core/parallel), so both compute the same thing.
+// The pieces of the multigrid V-cycle (multigrid.hpp) that see only vectors:
 //
 // * chebyshev_smooth: `degree` steps of the Chebyshev polynomial in D^{-1}A
 //   targeting [lmax/range, lmax]; `residual(x, r)` forms r = b - A x;
 // * lanczos_lmax: the largest eigenvalue of D^{-1}A from 15 steps of
 //   Jacobi-PCG (Lanczos), times 1.15, at least 2.3; dots through `reduce`
-//   (the sum over the ranks of a distributed level);
+//   (the sum over the ranks of a split level; null: one part);
 // * project_bottom_block: P^T B of a bottom-plane block, lumped per entry.
 #pragma once
 #include <functional>
@@ -14,6 +12,7 @@
 
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
+#include "core/util/reduction.hpp"
 
 namespace tresca {
 
@@ -38,9 +37,10 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
   }
 }
 
-// r: the start vector (overwritten); apply(p, q): q = A p
-real lanczos_lmax(index n, const std::function<void(const real*, real*)>& apply, const std::vector<real>& dinv,
-                  std::vector<real> r, const std::function<real(real)>& reduce = nullptr);
+// r: the start vector (overwritten); apply(p, q): q = A p (p is the
+// estimate's own vector: apply may update its ghost entries)
+real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const std::vector<real>& dinv,
+                  std::vector<real> r, const Reduction* reduce = nullptr);
 
 // the coarse bottom block P^T B of the fine one (4 fields of nx*ny each)
 std::vector<real> project_bottom_block(const Transfer& t, const std::vector<real>& fine);

@@ -1,0 +1,398 @@
+#include "core/multigrid/multigrid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+
+#include "kernels/boundary_block.hpp"
+#include "kernels/vector_ops.hpp"
+#include "core/multigrid/smoothing.hpp"
+#include "core/util/profile.hpp"
+
+namespace tresca {
+
+namespace {
+// Semi-coarsening: halve (rounding up) only the axes whose spacing is within
+// 1.5x of the finest one, so that anisotropic bricks become isotropic on the
+// coarse grids instead of flatter. Near-isotropic grids coarsen in all axes.
+GridDims coarsen(const GridDims& g) {
+  index* e[3] = {nullptr, nullptr, nullptr};
+  GridDims c = g;
+  e[0] = &c.ex;
+  e[1] = &c.ey;
+  e[2] = &c.ez;
+  const real h[3] = {g.hx(), g.hy(), g.hz()};
+  real hmin = INFINITY;
+  for (int a = 0; a < 3; ++a)
+    if (*e[a] > 1) hmin = std::min(hmin, h[a]);
+  for (int a = 0; a < 3; ++a)
+    if (*e[a] > 1 && h[a] <= 1.5 * hmin) *e[a] = (*e[a] + 1) / 2;
+  return c;
+}
+
+// local rows [first, last) of slab s as global rows
+void row_range(const Slab& s, index& first, index& last) {
+  first = s.y_begin - s.lo;
+  last = s.y_end + s.hi;
+}
+
+// The link from level f to level c on this rank: the sliced transfers and
+// the row fetches between split levels.
+GridHierarchy::Link make_link(const Transfer& T, const GridHierarchy::Level& f, const GridHierarchy::Level& c,
+                              const Comm& comm) {
+  GridHierarchy::Link k;
+  k.whole = k.restrict_t = k.prolong_t = T;
+  if (!f.distributed) return k;  // both whole
+  const Interp1D& Y = T.axis[1];
+  index f0, f1, c0, c1;
+  row_range(f.slab, f0, f1);
+  row_range(c.slab, c0, c1);
+  if (!c.distributed) k.prolong_t = slice_rows(T, f0, f1, 0, c.grid.ny());  // the coarse vector is whole here
+  // restriction onto the coarse local rows [c0, c1): the fine rows of their
+  // lists (onto a whole level: all of them, on rank 0 alone)
+  index a = f.grid.ny(), b = 0;
+  for (index j = c0; j < c1; ++j)
+    for (index t = Y.tstart[j]; t < Y.tstart[j + 1]; ++t) a = std::min(a, Y.tf[t]), b = std::max(b, Y.tf[t] + 1);
+  if (b - a < 2) b = std::min(f.grid.ny(), a + 2), a = b - 2;
+  if (!c.distributed && comm.rank() != 0) a = b = 0;
+  k.fetch_fine = std::make_shared<RowFetch>(f.slab, a, b, comm);
+  if (a == b) return k;  // (prolong_t above: the coarse vector is whole on every rank)
+  k.restrict_t = slice_rows(T, a, b, c0, c1);
+  // prolongation onto the fine local rows [f0, f1): the coarse rows they interpolate from
+  index ca = c.grid.ny(), cb = 0;
+  for (index i = f0; i < f1; ++i) ca = std::min(ca, Y.j0[i]), cb = std::max(cb, Y.j0[i] + 2);
+  cb = std::min(cb, c.grid.ny());
+  if (cb - ca < 2) ca = cb - 2;
+  if (c.distributed) {
+    k.fetch_coarse = std::make_shared<RowFetch>(c.slab, ca, cb, comm);
+    k.prolong_t = slice_rows(T, f0, f1, ca, cb);
+  }
+  return k;
+}
+
+// The Lanczos start vector's entry for global dof k: the (k+1)-th state of
+// a 64-bit linear congruential sequence from 12345, reached by jumping ahead
+// (so any rank's part of it is the same as the whole vector's).
+struct Lcg {
+  static constexpr std::uint64_t a = 6364136223846793005ULL, c = 1442695040888963407ULL;
+  // the state after n steps from s
+  static std::uint64_t jump(std::uint64_t s, std::uint64_t n) {
+    std::uint64_t A = 1, C = 0, ma = a, mc = c;  // (A, C): the map so far; (ma, mc): 2^i steps
+    for (; n; n >>= 1) {
+      if (n & 1) A = ma * A, C = ma * C + mc;
+      mc = ma * mc + mc;
+      ma = ma * ma;
+    }
+    return A * s + C;
+  }
+  static real value(std::uint64_t s) { return real((s >> 11) & 0xFFFFF) / real(0xFFFFF) - 0.5; }
+};
+
+}  // namespace
+
+const char* to_string(Precision p) { return p == Precision::single_precision ? "single" : "double"; }
+
+bool worth_distributing(const GridDims& g, const Comm& comm, index min_nodes_per_rank) {
+  const int P = comm.size();
+  return P > 1 && g.ny() >= 2 * P && g.nodes() / P >= min_nodes_per_rank;
+}
+
+std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, index coarse_nodes, const Comm& comm,
+                                                          index min_nodes_per_rank) {
+  auto h = std::make_shared<GridHierarchy>();
+  h->comm = &comm;
+  GridDims g = fine;
+  for (;;) {
+    h->grids.push_back(g);
+    if (g.nodes() <= coarse_nodes || (g.ex == 1 && g.ey == 1 && g.ez == 1)) break;
+    g = coarsen(g);
+  }
+  bool whole = false;  // once a level is whole, so are the coarser ones
+  for (size_t l = 0; l < h->grids.size(); ++l) {
+    Level lv;
+    lv.grid = h->grids[l];
+    const bool coarsest = l + 1 == h->grids.size();  // solved by a factorisation
+    whole = whole || coarsest || !worth_distributing(lv.grid, comm, min_nodes_per_rank);
+    lv.distributed = !whole;
+    lv.slab = lv.distributed ? make_slab(lv.grid, comm.rank(), comm.size()) : make_slab(lv.grid, 0, 1);
+    h->levels.push_back(lv);
+  }
+  for (size_t l = 0; l + 1 < h->levels.size(); ++l)
+    h->to_coarse.push_back(make_link(build_transfer(h->grids[l], h->grids[l + 1]), h->levels[l], h->levels[l + 1], comm));
+  return h;
+}
+
+bool GridHierarchy::agglomerated(int l) const {
+  return comm->distributed() && !levels[l].distributed && (l == 0 || levels[l - 1].distributed);
+}
+
+int GridHierarchy::distributed_levels() const {
+  int k = 0;
+  for (const Level& lv : levels) k += lv.distributed ? 1 : 0;
+  return k;
+}
+
+Rediscretisation elasticity_on(unsigned faces, real E, real nu) {
+  return [=](const Slab& s) { return ElasticityOperator(s, faces, E, nu); };
+}
+
+Multigrid::Multigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt, const Comm& comm)
+    : Multigrid(GridHierarchy::build(fine, opt.coarse_nodes, comm), elasticity_on(faces, E, nu), opt) {}
+
+Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt,
+                     const Multigrid* like)
+    : opt_(opt), grids_(std::move(grids)) {
+  if (!grids_ || grids_->levels.empty()) throw std::invalid_argument("multigrid: empty grid hierarchy");
+  if (like && like->grids_ != grids_)
+    throw std::invalid_argument("multigrid: spectral bounds can only be shared on the same hierarchy");
+  for (const GridHierarchy::Level& h : grids_->levels) {
+    Level lv;
+    lv.A = op(h.slab);
+    if (lv.A.grid().nodes() != h.slab.local.nodes())
+      throw std::invalid_argument("multigrid: the rediscretised operator does not live on the hierarchy's grid");
+    levels_.push_back(std::move(lv));
+  }
+  for (int l = 0; l + 1 < num_levels(); ++l) {
+    if (like)
+      levels_[l].lmax = like->levels_[l].lmax;
+    else
+      estimate_lmax(l);
+  }
+  factor_coarse();
+  if (opt_.precision == Precision::single_precision)
+    build_work<float>();
+  else
+    build_work<double>();
+}
+
+template <>
+std::vector<Multigrid::Work<double>>& Multigrid::work<double>() {
+  return work_d_;
+}
+template <>
+std::vector<Multigrid::Work<float>>& Multigrid::work<float>() {
+  return work_s_;
+}
+template <>
+const std::vector<Multigrid::Work<double>>& Multigrid::work<double>() const {
+  return work_d_;
+}
+template <>
+const std::vector<Multigrid::Work<float>>& Multigrid::work<float>() const {
+  return work_s_;
+}
+
+template <class T>
+void Multigrid::build_work() {
+  std::vector<Work<T>>& W = work<T>();
+  W.resize(levels_.size());
+  for (size_t l = 0; l < levels_.size(); ++l) {
+    Work<T>& w = W[l];
+    const index n = levels_[l].A.size();
+    w.r.resize(n);
+    w.d.resize(n);
+    // a double level 0 solves in the caller's arrays (apply sets xp, bp)
+    if (l > 0 || !std::is_same<T, real>::value) {
+      w.x.resize(n);
+      w.b.resize(n);
+      w.xp = w.x.data();
+      w.bp = w.b.data();
+    }
+    if (l + 1 < levels_.size()) {
+      const GridHierarchy::Link& k = grids_->to_coarse[l];
+      if (k.fetch_fine) w.fine_rows.resize(k.fetch_fine->size());
+      if (k.fetch_coarse) w.coarse_rows.resize(k.fetch_coarse->size());
+    }
+  }
+  refresh_work<T>();
+}
+
+template <class T>
+void Multigrid::refresh_work() {
+  std::vector<Work<T>>& W = work<T>();
+  for (size_t l = 0; l < levels_.size(); ++l) {
+    const std::vector<real> d = levels_[l].A.diagonal();
+    W[l].dinv.resize(d.size());
+    for (size_t i = 0; i < d.size(); ++i) W[l].dinv[i] = d[i] != 0 ? T(1 / d[i]) : T(0);  // ghost rows: 0
+  }
+}
+
+void Multigrid::estimate_lmax(int l) {
+  Level& lv = levels_[l];
+  const GridHierarchy::Level& h = grids_->levels[l];
+  const index n = lv.A.size();
+  std::vector<real> r(n), dinv = lv.A.diagonal();
+  for (real& v : dinv) v = v != 0 ? 1 / v : 0;
+  // the start vector by global dof index: runs of nx entries (one node row)
+  const GridDims &box = h.slab.local, &G = h.grid;
+  const index N = box.nodes(), row0 = h.slab.y_begin - h.slab.lo;
+  for (int c = 0; c < 3; ++c)
+    for (index iz = 0; iz < box.nz(); ++iz)
+      for (index j = 0; j < box.ny(); ++j) {
+        const index k0 = c * G.nodes() + G.node(0, row0 + j, iz);
+        std::uint64_t s = Lcg::jump(12345, std::uint64_t(k0) + 1);
+        real* out = r.data() + c * N + box.node(0, j, iz);
+        for (index ix = 0; ix < box.nx(); ++ix, s = Lcg::a * s + Lcg::c) out[ix] = Lcg::value(s);
+      }
+  zero_constrained(box, lv.A.faces(), r.data());
+  lv.A.zero_ghosts(r.data());
+  lv.lmax = lanczos_lmax(
+      n,
+      [&](real* p, real* q) {
+        lv.A.update_ghosts(p);
+        lv.A.apply(p, q);
+      },
+      dinv, std::move(r), h.distributed ? grids_->comm : nullptr);
+}
+
+void Multigrid::factor_coarse() {
+  // rank 0 factorises and solves the coarsest level (vcycle)
+  const index n = levels_.back().A.size();
+  cb_.resize(n);
+  cx_.resize(n);
+  if (comm().rank() != 0) return;
+  SparseMatrix A = assemble(levels_.back().A);
+  coarse_.compute(A);
+  if (coarse_.info() != Eigen::Success) throw std::runtime_error("multigrid: coarse factorisation failed");
+}
+
+void Multigrid::set_bottom_block(const std::vector<real>& B) {
+  const GridDims& g0 = grids_->grids[0];
+  if (!B.empty() && index(B.size()) != 4 * g0.nx() * g0.ny())
+    throw std::invalid_argument("multigrid: bottom block has " + std::to_string(B.size()) + " entries, expected 4 x " +
+                                std::to_string(g0.nx() * g0.ny()));
+  std::vector<real> Bl = B;  // this level's, whole plane
+  for (size_t l = 0; l < levels_.size(); ++l) {
+    const ElasticityOperator& A = levels_[l].A;
+    zero_constrained_bottom_block(grids_->grids[l], A.global_faces(), Bl);
+    levels_[l].A.set_bottom_block(Bl);
+    if (l + 1 == levels_.size() || Bl.empty()) continue;
+    Bl = project_bottom_block(grids_->to_coarse[l].whole, Bl);  // P^T B
+  }
+  factor_coarse();
+  if (opt_.precision == Precision::single_precision)
+    refresh_work<float>();
+  else
+    refresh_work<double>();
+}
+
+template <class T>
+void Multigrid::residual(int l, const T* b, T* x, T* r) const {
+  const ElasticityOperator& A = levels_[l].A;
+  A.update_ghosts(x);
+  A.residual(b, x, r);
+}
+
+template <class T>
+void Multigrid::smooth(int l, bool zero_guess) const {
+  const Work<T>& w = work<T>()[l];
+  ScopedTimer t(Kernel::smoother);
+  chebyshev_smooth<T>(levels_[l].A.size(), levels_[l].lmax, opt_.range, opt_.degree, zero_guess, w.dinv.data(), w.bp,
+                      w.xp, w.r.data(), w.d.data(), [&](T* x, T* r) { residual<T>(l, w.bp, x, r); });
+}
+
+template <class T>
+void Multigrid::restrict_residual(int l) const {
+  // b_c = P^T r (the fine rows other ranks own fetched first)
+  const Work<T>& w = work<T>()[l];
+  const Work<T>& cw = work<T>()[l + 1];
+  const GridHierarchy::Link& k = grids_->to_coarse[l];
+  const ElasticityOperator& C = levels_[l + 1].A;
+  ScopedTimer t(Kernel::restrict_, double(w.r.size()) * in_precision<T>(kRestrictCost));
+  const T* fine = w.r.data();
+  if (k.fetch_fine) {
+    k.fetch_fine->fetch<T>(w.r.data(), w.fine_rows.data());
+    fine = w.fine_rows.data();
+  }
+  if (grids_->agglomerated(l + 1) && comm().rank() != 0) return;
+  restrict_to_coarse<T>(k.restrict_t, 3, fine, cw.b.data());
+  zero_constrained<T>(C.grid(), C.faces(), cw.b.data());
+  C.zero_ghosts(cw.b.data());
+}
+
+template <class T>
+void Multigrid::prolongate_correction(int l) const {
+  // x += P x_c (the coarse rows other ranks own fetched first); the
+  // correction vanishes on constrained faces (they are interpolated from
+  // constrained coarse nodes only), the mask makes it exact
+  const Work<T>& w = work<T>()[l];
+  const Work<T>& cw = work<T>()[l + 1];
+  const GridHierarchy::Link& k = grids_->to_coarse[l];
+  const ElasticityOperator& A = levels_[l].A;
+  ScopedTimer t(Kernel::prolongate, double(w.r.size()) * in_precision<T>(kProlongateCost));
+  const T* coarse = cw.x.data();
+  if (k.fetch_coarse) {
+    k.fetch_coarse->fetch<T>(cw.x.data(), w.coarse_rows.data());
+    coarse = w.coarse_rows.data();
+  }
+  prolongate<T>(k.prolong_t, 3, coarse, w.xp, true);
+  zero_constrained<T>(A.grid(), A.faces(), w.xp);
+}
+
+template <class T>
+void Multigrid::vcycle(int l) const {
+  const Work<T>& w = work<T>()[l];
+  const index n = levels_[l].A.size();
+  if (l + 1 == num_levels()) {  // on rank 0 (every rank if all levels are whole)
+    ScopedTimer t(Kernel::coarse_solve);
+    for (index i = 0; i < n; ++i) cb_[i] = real(w.bp[i]);
+    cx_ = coarse_.solve(cb_);
+    for (index i = 0; i < n; ++i) w.xp[i] = T(cx_[i]);
+    return;
+  }
+  smooth<T>(l, true);
+  residual<T>(l, w.bp, w.xp, w.r.data());
+  restrict_residual<T>(l);
+  if (grids_->agglomerated(l + 1)) {
+    // the coarse levels on rank 0 alone; their correction to every rank
+    const Work<T>& cw = work<T>()[l + 1];
+    if (comm().rank() == 0) vcycle<T>(l + 1);
+    comm().broadcast(cw.x.data(), int(cw.x.size()));
+  } else {
+    vcycle<T>(l + 1);
+  }
+  prolongate_correction<T>(l);
+  smooth<T>(l, false);
+}
+
+void Multigrid::apply(const real* r, real* z) const {
+  const index n = size();
+  // every level whole on several ranks: rank 0 alone, the answer to all
+  const bool alone = grids_->agglomerated(0), run = !alone || comm().rank() == 0;
+  if (opt_.precision == Precision::double_precision) {
+    work_d_[0].bp = r;
+    work_d_[0].xp = z;
+    if (run) vcycle<double>(0);
+  } else {
+    const Work<float>& w = work_s_[0];
+    convert<float>(n, r, w.b.data());
+    if (run) vcycle<float>(0);
+    convert<double>(n, w.x.data(), z);
+  }
+  if (alone) comm().broadcast(z, int(n));
+  levels_[0].A.zero_ghosts(z);
+}
+
+double Multigrid::cycle_work() const {
+  double w = 0;
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) w += double(grids_->grids[l].nodes());
+  return 2.0 * opt_.degree * w / double(grids_->grids[0].nodes());
+}
+
+std::string Multigrid::describe() const {
+  std::ostringstream os;
+  os << levels_.size() << " levels:";
+  for (const GridHierarchy::Level& h : grids_->levels)
+    os << " " << h.grid.ex << "x" << h.grid.ey << "x" << h.grid.ez << (h.distributed ? "(d)" : "");
+  os << " (" << to_string(opt_.precision) << " precision";
+  if (comm().distributed())
+    os << "; (d): split over " << comm().size() << " ranks, the others agglomerated on rank 0";
+  os << ")";
+  return os.str();
+}
+
+}  // namespace tresca

@@ -1,0 +1,196 @@
+// Geometric multigrid V-cycle for the Q1 elasticity operator on the brick
+// grid, used as a preconditioner (one V-cycle with zero initial guess per
+// apply), on one rank or on y-slabs of several.
+//
+// Hierarchy (GridHierarchy, built once per solve and shared by every
+// multigrid on that grid: the K_ii solver and the Newton-step
+// preconditioner): each coarser grid has ceil(e/2) elements along every axis
+// whose spacing is within 1.5x of the finest (semi-coarsening for
+// anisotropic bricks; all axes on the benchmark's near-cubic bricks),
+// non-nested when e is odd, the same box and constrained faces, and is
+// rediscretised (same brick formula, coarse h). Transfers are trilinear
+// interpolation and its exact transpose (kernels/transfer.hpp). Coarsening
+// stops when a grid has at most `coarse_nodes` nodes; that grid is solved
+// directly (Eigen sparse LDLT of the assembled matrix, factorised once).
+//
+// Ranks: a level is either whole or split into y-slabs (slab.hpp), one per
+// rank. One rank is the case where every level is whole. On several ranks,
+// fine levels with at least 2 node rows and `min_nodes_per_rank` nodes per
+// rank are split: each rank holds its slab and applies A with a halo
+// exchange (elasticity_operator.hpp); the first whole level and every
+// coarser one are agglomerated onto rank 0 (the residual gathered there,
+// rank 0 alone runs the coarse levels, the correction broadcast). Transfers
+// between split levels fetch the rows that neighbours own (row_fetch.hpp).
+// Every line above the exchanges and the reductions is the same for one
+// rank and many.
+//
+// Smoother: Chebyshev polynomial of degree `degree` in D^{-1}A (Jacobi),
+// targeting [lmax/range, lmax]; lmax from 15 steps of Jacobi-PCG (Lanczos),
+// times 1.15, from a start vector that depends on the global dof index only
+// (the same on any rank count). The same polynomial pre and post keeps the
+// V-cycle symmetric, so it is a valid CG preconditioner.
+//
+// Optional bottom-face block B (elasticity_operator.hpp): coarse levels get
+// the lumped Galerkin projection B_c = P^T B_f (restricted per entry), which
+// preserves row sums of P^T B P. The coarse factorisation is redone.
+//
+// Precision: the V-cycle runs in double, or in single precision (float
+// stencils, transfers, smoother vectors; input and output converted at the
+// finest level; the coarsest grid is solved in double). Single precision
+// halves the bytes and doubles the vector lanes of every V-cycle kernel. As
+// a preconditioner of a double-precision CG it only has to be a good
+// approximate inverse: its rounding (relative 1e-7) is far below what the
+// V-cycle itself leaves, so the CG iteration count does not change (tests:
+// MultigridCG.SinglePrecisionVCycleKeepsIterationsAndAccuracy).
+//
+// Cost per V-cycle on a level with n dofs: (2*degree) applies of A, plus
+// residual apply, one restriction and one prolongation: about
+// (2*degree+1) * 306/3 + 20 flops per dof; the hierarchy adds about 1/7.
+#pragma once
+#include <Eigen/SparseCholesky>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "kernels/transfer.hpp"
+#include "core/fem/assembly.hpp"
+#include "core/fem/elasticity_operator.hpp"
+#include "core/parallel/comm.hpp"
+#include "core/parallel/row_fetch.hpp"
+
+namespace tresca {
+
+enum class Precision { double_precision, single_precision };
+const char* to_string(Precision p);
+
+struct MGOptions {
+  int degree = 3;
+  real range = 15;
+  index coarse_nodes = 400;  // used when the hierarchy is built (GridHierarchy::build)
+  Precision precision = Precision::single_precision;
+};
+
+// whether a grid is split over the ranks of comm: more than one rank, at
+// least 2 node rows and min_nodes_per_rank nodes per rank
+bool worth_distributing(const GridDims& g, const Comm& comm, index min_nodes_per_rank = 2048);
+
+// The grids of a multigrid hierarchy, how each is held by the ranks, and
+// the transfers between them.
+struct GridHierarchy {
+  struct Level {
+    GridDims grid;             // the whole grid
+    Slab slab;                 // this rank's part: its slab if split, else the whole grid
+    bool distributed = false;  // split over the ranks
+  };
+  // from level l to l + 1
+  struct Link {
+    Transfer whole;                 // between the whole grids
+    Transfer restrict_t, prolong_t; // the rows this rank computes (whole: `whole`)
+    // rows that other ranks own: the fine rows the coarse rows restrict from,
+    // the coarse rows the fine rows interpolate from (null: none needed)
+    std::shared_ptr<RowFetch> fetch_fine, fetch_coarse;
+  };
+  std::vector<GridDims> grids;  // finest first
+  std::vector<Level> levels;
+  std::vector<Link> to_coarse;
+  const Comm* comm = nullptr;
+  // level l is the first whole level on several ranks: it and the coarser
+  // ones are computed by rank 0 alone
+  bool agglomerated(int l) const;
+  int distributed_levels() const;
+  // semi-coarsening until a grid has at most coarse_nodes nodes; levels
+  // split over comm's ranks where worth_distributing (Comm::self(): all whole)
+  static std::shared_ptr<const GridHierarchy> build(const GridDims& fine, index coarse_nodes,
+                                                    const Comm& comm = Comm::self(), index min_nodes_per_rank = 2048);
+};
+
+// The description of the operator a multigrid preconditions: its
+// rediscretisation on this rank's part of any grid of the hierarchy (the
+// finest included). Other materials or constrained faces plug in here;
+// per-node boundary terms come in through set_bottom_block.
+using Rediscretisation = std::function<ElasticityOperator(const Slab&)>;
+// isotropic elasticity (E, nu) with the given constrained faces on every grid
+Rediscretisation elasticity_on(unsigned faces, real E, real nu);
+
+class Multigrid : public LinearOperator {
+ public:
+  // like: take the smoother's spectral bounds from that multigrid (its
+  // hierarchy must be `grids`) instead of estimating them, for an operator
+  // whose Jacobi-scaled spectrum is the same up to boundary terms (the K + B
+  // preconditioner of the Newton step against the K_ii solver: within 0.3 %,
+  // inside the 1.15 margin; perf/RESULTS.md)
+  Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt = {},
+            const Multigrid* like = nullptr);
+  // builds its own hierarchy (opt.coarse_nodes) for elasticity on `fine`
+  Multigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt = {},
+            const Comm& comm = Comm::self());
+  // on level-0 vectors: this rank's slab (the whole grid on one rank)
+  index size() const override { return levels_[0].A.size(); }
+  void apply(const real* r, real* z) const override;
+
+  int num_levels() const { return int(levels_.size()); }
+  const MGOptions& options() const { return opt_; }
+  const std::shared_ptr<const GridHierarchy>& hierarchy() const { return grids_; }
+  // the sum over the ranks for dots of level-0 vectors: the ranks if level 0
+  // is split, null if every rank holds it whole
+  const Reduction* reduction() const { return grids_->levels[0].distributed ? grids_->comm : nullptr; }
+  // work of one V-cycle in applications of the finest operator: 2*degree
+  // residual applies on every level but the coarsest, weighted by its size
+  // (transfers, vector updates and the coarse solve not counted)
+  double cycle_work() const;
+  // the (double-precision) operator of a level on this rank's part; op(0)
+  // is the operator this V-cycle preconditions
+  const ElasticityOperator& op(int level) const { return levels_[level].A; }
+  real lmax(int level) const { return levels_[level].lmax; }
+  // B of the finest level over the WHOLE bottom plane (4 fields of nx*ny,
+  // elasticity_operator.hpp), the same on every rank; every level gets its
+  // projection P^T B. Empty removes it.
+  void set_bottom_block(const std::vector<real>& B);
+  std::string describe() const;
+
+ private:
+  struct Level {
+    ElasticityOperator A;  // double: lmax estimate, coarse factorisation, op()
+    real lmax = 0;
+  };
+  // The V-cycle's vectors of one level in precision T.
+  template <class T>
+  struct Work {
+    std::vector<T> dinv;  // 1 / diag(K + B), 0 on ghost rows
+    mutable std::vector<T> x, b, r, d, fine_rows, coarse_rows;
+    mutable T* xp = nullptr;  // iterate and right-hand side in use: the
+    mutable const T* bp = nullptr;  // caller's arrays on a double level 0
+  };
+  template <class T>
+  std::vector<Work<T>>& work();
+  template <class T>
+  const std::vector<Work<T>>& work() const;
+  template <class T>
+  void build_work();
+  template <class T>
+  void refresh_work();  // dinv from the levels' operators
+  template <class T>
+  void residual(int l, const T* b, T* x, T* r) const;
+  template <class T>
+  void smooth(int l, bool zero_guess) const;
+  template <class T>
+  void vcycle(int l) const;
+  template <class T>
+  void restrict_residual(int l) const;
+  template <class T>
+  void prolongate_correction(int l) const;
+  void factor_coarse();
+  void estimate_lmax(int l);
+  const Comm& comm() const { return *grids_->comm; }
+
+  MGOptions opt_;
+  std::shared_ptr<const GridHierarchy> grids_;
+  std::vector<Level> levels_;
+  std::vector<Work<double>> work_d_;
+  std::vector<Work<float>> work_s_;
+  Eigen::SimplicialLDLT<SparseMatrix> coarse_;  // on rank 0 (every rank when all levels are whole)
+  mutable Eigen::VectorXd cb_, cx_;
+};
+
+}  // namespace tresca
