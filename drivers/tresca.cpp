@@ -147,7 +147,7 @@ int main(int argc, char** argv) {
     if (a.has("--problem")) {
       if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's problem; it takes no --problem");
       file = read_problem_file(a.str("--problem"));
-      if (file.coulomb >= 0 && !a.has("--phi")) opt.coulomb = file.coulomb;
+      if (!a.has("--phi")) opt.friction = file.friction;
     }
     spec = spec_from_args(a, 6, a.has("--problem") ? &file.spec : nullptr);
     if (a.has("--gap-file")) {
@@ -195,13 +195,13 @@ int main(int argc, char** argv) {
     const long long degree = a.int_value("--mg-degree", opt.mg.degree);
     if (degree < 1 || degree > 8) throw std::invalid_argument("--mg-degree " + a.str("--mg-degree") + " must be in 1..8");
     opt.mg.degree = int(degree);
-    if (a.has("--phi")) opt.coulomb = -1;  // the command line's Tresca bound over a file's Coulomb
-    const std::string method = a.str("--coulomb-method", to_string(RunOptions{}.coulomb_method));
-    opt.coulomb_method = coulomb_method_from(method, "--coulomb-method");
+    if (a.has("--phi")) opt.friction = tresca_friction();  // the command line's Tresca bound over a file's Coulomb
+    opt.friction.method = coulomb_method_from(a.str("--coulomb-method", to_string(FrictionLaw{}.method)), "--coulomb-method");
     if (a.has("--coulomb")) {
-      opt.coulomb = a.real_value("--coulomb", 0);
-      if (!(opt.coulomb >= 0) || !std::isfinite(opt.coulomb))
+      const real F = a.real_value("--coulomb", 0);
+      if (!(F >= 0) || !std::isfinite(F))
         throw std::invalid_argument("--coulomb " + a.str("--coulomb") + " must be a friction coefficient >= 0");
+      opt.friction = coulomb_friction(F, opt.friction.method);
       if (a.has("--phi")) throw std::invalid_argument("--coulomb and --phi exclude each other (Coulomb: phi_i = F lambda_i)");
       if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's Tresca case; it takes no --coulomb");
     }
@@ -340,8 +340,8 @@ int main(int argc, char** argv) {
                    int(placement.thread_cpus.size()), placement.cpus, placement.describe().c_str());
     if (!quiet) {
       char friction[64];
-      if (opt.coulomb >= 0)
-        std::snprintf(friction, sizeof friction, "Coulomb F %g", opt.coulomb);
+      if (opt.friction.is_coulomb())
+        std::snprintf(friction, sizeof friction, "Coulomb F %g", opt.friction.F);
       else
         std::snprintf(friction, sizeof friction, "phi %g", spec.phi);
       std::printf("tresca: mesh %s (level %s), %lld nodes, %lld contact nodes, %lld dofs, %s, obstacle %s, eps %g, %d threads%s\n",
@@ -376,19 +376,18 @@ int main(int argc, char** argv) {
     const FinalReport& F = R.report;
     char last[64] = "n/a (no approximation step)";
     if (!N.history.empty()) std::snprintf(last, sizeof last, "%.3e", N.history.back());
-    if (R.coulomb) {
+    if (R.coulomb()) {
       const CoulombResult& C = R.coulomb_loop;
       if (R.coulomb_fallback)
         std::printf("Coulomb F = %g: the Newton solve did not converge; the fixed point of Tresca solves took over\n",
-                    opt.coulomb);
-      if (opt.coulomb_method != RunOptions::CoulombMethod::fixed_point && !R.coulomb_fallback) {
+                    R.friction.F);
+      if (opt.friction.bound_follows_lambda() && !R.coulomb_fallback) {
         std::printf("Coulomb F = %g, the bound phi_i = F lambda_i %s at every Newton step; max |phi_i - F lambda_i| = %.2e N\n",
-                    opt.coulomb,
-                    opt.coulomb_method == RunOptions::CoulombMethod::newton ? "differentiated" : "updated",
+                    R.friction.F, opt.friction.differentiates_bound() ? "differentiated" : "updated",
                     R.coulomb_consistency);
       } else {
         std::printf("Coulomb F = %g: %s after %d Tresca solves, %lld Newton steps in all (reason: %s); changes of phi:",
-                    opt.coulomb, C.converged() ? "converged" : "NOT CONVERGED", C.iterations, C.newton_steps,
+                    R.friction.F, C.converged() ? "converged" : "NOT CONVERGED", C.iterations, C.newton_steps,
                     to_string(C.reason));
         for (real c : C.changes) std::printf(" %.1e", c);
         std::printf("\nthe last Tresca solve (phi_i = F lambda_i of the one before, max |phi_i - F lambda_i| = %.2e N):\n",

@@ -48,9 +48,9 @@ int main(int argc, char** argv) {
     }
     const double phi = a.real_value("--phi", 1.0);
     const bool nested = !a.has("--no-nested");
-    const double coulomb = a.has("--coulomb") ? a.real_value("--coulomb", 0) : -1;
-    const RunOptions::CoulombMethod method = coulomb_method_from(a.str("--coulomb-method", to_string(RunOptions{}.coulomb_method)), "--coulomb-method");
-    if (a.has("--coulomb") && !(coulomb >= 0)) throw std::invalid_argument("--coulomb " + a.str("--coulomb") + " must be >= 0");
+    const FrictionLaw::CoulombMethod method =
+        coulomb_method_from(a.str("--coulomb-method", to_string(FrictionLaw{}.method)), "--coulomb-method");
+    const FrictionLaw friction = a.has("--coulomb") ? coulomb_friction(a.real_value("--coulomb", 0), method) : tresca_friction();
     const std::string json = a.str("--json");
     if (!json.empty()) check_writable(json);
     for (int L : levels) check_memory(spec_for_level(L));
@@ -59,7 +59,8 @@ int main(int argc, char** argv) {
     std::printf("# nested iteration %s; newton, outer, inner, S-app, fmv/step: this mesh; fmv nest: the coarser meshes;\n"
                 "# fmv/solve: all of it (coarser meshes, |b~|, Newton, final check and recovery); condense: the loose |b~|\n",
                 nested ? "on" : "off (--no-nested)");
-    if (coulomb >= 0) std::printf("# Coulomb F = %g: fp = fixed-point iterations (Tresca solves), newton = all their steps\n", coulomb);
+    if (friction.is_coulomb())
+      std::printf("# Coulomb F = %g: fp = fixed-point iterations (Tresca solves), newton = all their steps\n", friction.F);
     std::printf("%5s %3s %10s %8s %8s %8s %8s %8s %8s %4s %6s %6s %6s %6s %8s %8s %9s %8s %6s %8s %7s\n", "level", "thr",
                 "dofs", "nested", "setup", "condense", "solve", "recover", "total", "fp", "newton", "outer", "inner", "S-app",
                 "fmv/step", "fmv nest", "fmv/solve", "fmv K_ii", "ratio", "peak GB", "speedup");
@@ -85,14 +86,13 @@ int main(int argc, char** argv) {
         RunOptions o;
         o.recover_interior = true;
         o.nested = nested;
-        o.coulomb = coulomb;
-        o.coulomb_method = method;
+        o.friction = friction;
         const RunResult R = run_tresca(s, o);
         if (T == threads.front()) t_first = R.times.total;
         const double speedup = t_first / R.times.total;
         std::printf("%5d %3d %10lld %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %4d %6d %6lld %6lld %6lld %8.1f %8.1f %9.1f %8.1f %6.1f %8.2f %7.2f %s\n",
                     L, T, (long long)R.problem->free_dofs(), R.times.nested, R.times.setup, R.times.condense,
-                    R.times.solve, R.times.recover, R.times.total, R.coulomb ? R.coulomb_loop.iterations : 0,
+                    R.times.solve, R.times.recover, R.times.total, R.coulomb() ? R.coulomb_loop.iterations : 0,
                     int(R.newton_steps()), R.newton.outer_iterations,
                     R.inner_iterations, R.newton.operator_applications, R.fine_matvecs_per_newton_step(),
                     R.nested_fine_matvecs, R.fine_matvecs_total, fmv_linear,

@@ -1,5 +1,5 @@
 // Coulomb friction, both ways: the bound lagged by one Newton step
-// (NewtonOptions::coulomb, the default) and the fixed point of Tresca solves
+// (FrictionLaw::CoulombMethod::newton, the default) and the fixed point of Tresca solves
 // (core/contact/coulomb.hpp). The converged solution is a fixed point of
 // Tresca, both methods agree, F = 0 is frictionless, and the report is
 // honest when the fixed point is cut short.
@@ -15,12 +15,12 @@
 namespace tresca {
 
 namespace {
-using Method = RunOptions::CoulombMethod;
+using Method = FrictionLaw::CoulombMethod;
 RunResult solve(const ProblemSpec& spec, real F, bool nested = true, Method m = Method::lagged) {
   RunOptions o;
-  o.coulomb_method = m;
+
   o.recover_interior = false;
-  o.coulomb = F;
+  o.friction = coulomb_friction(F, m);
   o.nested = nested;
   o.nested_min_contact_nodes = 40;
   return run_tresca(spec, o);
@@ -35,7 +35,7 @@ void fixed_point_of_tresca(Method method) {
   const real F = 1.5;
   const RunResult C = solve(spec, F, true, method);
   ASSERT_TRUE(C.converged()) << C.reason();
-  ASSERT_TRUE(C.coulomb);
+  ASSERT_TRUE(C.coulomb());
   if (method == Method::fixed_point) {
     EXPECT_GT(C.coulomb_loop.iterations, 1);
   }

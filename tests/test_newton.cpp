@@ -377,7 +377,7 @@ TEST(SemismoothNewton, MatchesDenseReferenceWhereThePaperStepLosesThePath) {
   compare_with_dense({}, 12, 6, 6, [](index i) { return uniform(1e6, i); }, false, true);
 }
 
-// The Coulomb Newton step (NewtonOptions::coulomb_newton) against the dense
+// The Coulomb Newton step (FrictionLaw::CoulombMethod::newton) against the dense
 // 4p system with the friction force's λ column in H: from every dense
 // iterate one matrix-free step (GMRES, near-exact) gives the next, and the
 // whole runs reach the same solution where nodes stick, slide and separate.
@@ -386,8 +386,7 @@ TEST(SemismoothNewton, CoulombStepMatchesDenseReference) {
   const ProblemSpec spec = spec_for_dims(12, 6, 6);
   RunOptions o;
   o.recover_interior = false;
-  o.coulomb = F;
-  o.coulomb_method = RunOptions::CoulombMethod::newton;
+  o.friction = coulomb_friction(F, FrictionLaw::CoulombMethod::newton);
   const RunResult R = run_tresca(spec, o);
   ASSERT_TRUE(R.converged()) << R.reason();
   ASSERT_FALSE(R.coulomb_fallback);
@@ -398,8 +397,7 @@ TEST(SemismoothNewton, CoulombStepMatchesDenseReference) {
   const DenseNewton ref = dense_newton(D.S, D.b, {}, 0, scale, 1e-6, 60, F, scale);
   ASSERT_LE(ref.history.back(), 1e-6) << "dense reference did not converge";
   NewtonOptions method;
-  method.coulomb = F;
-  method.coulomb_newton = true;
+  method.friction = coulomb_friction(F, FrictionLaw::CoulombMethod::newton);
   expect_dense_steps(S, D, ref, ContactConditions::uniform(p, 0, 0), method, R.newton);
   real umax, lmax;
   const auto e = iterate_errors(R.newton.u, R.newton.lambda, ref.x, umax, lmax);

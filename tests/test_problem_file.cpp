@@ -26,7 +26,7 @@ TEST(ProblemFile, EmptyFileIsTheSeedBenchmark) {
   const ProblemFile f = parse_problem("// nothing but a comment\n{}");
   const ProblemSpec d;
   EXPECT_FALSE(f.mesh_given);
-  EXPECT_LT(f.coulomb, 0);
+  EXPECT_FALSE(f.friction.is_coulomb());
   EXPECT_EQ(f.spec.E, d.E);
   EXPECT_EQ(f.spec.phi, d.phi);
   EXPECT_EQ(f.spec.traction, d.traction);
@@ -42,10 +42,11 @@ TEST(ProblemFile, EveryKeyIsReadAndWrittenBackTheSame) {
   s.load_scale = 0.75;
   s.obstacle.kind = Obstacle::Kind::sphere;
   s.obstacle.radius = 3, s.obstacle.cx = -0.2, s.obstacle.cy = 2.3, s.obstacle.gap = 0.01;
-  const ProblemFile f = parse_problem(problem_json(s, 0.4));
+  const ProblemFile f = parse_problem(problem_json(s, coulomb_friction(0.4)));
   const ProblemSpec& r = f.spec;
   EXPECT_TRUE(f.mesh_given);
-  EXPECT_EQ(f.coulomb, 0.4);
+  EXPECT_TRUE(f.friction.is_coulomb());
+  EXPECT_EQ(f.friction.F, 0.4);
   EXPECT_EQ(r.ex, 7);
   EXPECT_EQ(r.ey, 5);
   EXPECT_EQ(r.ez, 3);
@@ -66,14 +67,14 @@ TEST(ProblemFile, EveryKeyIsReadAndWrittenBackTheSame) {
   s.phi = 5e5;
   s.obstacle = Obstacle{};
   s.obstacle.kind = Obstacle::Kind::cylinder, s.obstacle.radius = 1, s.obstacle.cy = 2.4;
-  ProblemFile g = parse_problem(problem_json(s, -1));
-  EXPECT_LT(g.coulomb, 0);
+  ProblemFile g = parse_problem(problem_json(s, tresca_friction()));
+  EXPECT_FALSE(g.friction.is_coulomb());
   EXPECT_EQ(g.spec.phi, 5e5);
   EXPECT_EQ(g.spec.obstacle.kind, Obstacle::Kind::cylinder);
   EXPECT_EQ(g.spec.obstacle.cy, 2.4);
   s.obstacle = Obstacle{};
   s.obstacle.gap = 0.1, s.obstacle.slope_x = 0.01, s.obstacle.slope_y = -0.02;
-  g = parse_problem(problem_json(s, -1));
+  g = parse_problem(problem_json(s, tresca_friction()));
   EXPECT_EQ(g.spec.obstacle.kind, Obstacle::Kind::plane);
   EXPECT_EQ(g.spec.obstacle.slope_y, -0.02);
 }

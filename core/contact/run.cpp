@@ -26,24 +26,9 @@ ContactConditions contact_conditions(const ProblemSpec& spec) {
   return c;
 }
 
-const char* to_string(RunOptions::CoulombMethod m) {
-  switch (m) {
-    case RunOptions::CoulombMethod::lagged: return "lagged";
-    case RunOptions::CoulombMethod::newton: return "newton";
-    case RunOptions::CoulombMethod::fixed_point: return "fixed_point";
-  }
-  return "?";
-}
-
-RunOptions::CoulombMethod coulomb_method_from(const std::string& s, const std::string& option) {
-  if (s == "lagged") return RunOptions::CoulombMethod::lagged;
-  if (s == "newton") return RunOptions::CoulombMethod::newton;
-  if (s == "fixed-point" || s == "fixed_point") return RunOptions::CoulombMethod::fixed_point;
-  throw std::invalid_argument(option + " '" + s + "' must be newton, lagged or fixed-point");
-}
-
 RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   RunResult R;
+  R.friction = opt.friction;
   const double t0 = wall_time();
   R.problem = std::make_unique<Problem>(make_problem(spec));
   R.contact = opt.contact.phi.empty() ? contact_conditions(spec) : opt.contact;
@@ -162,7 +147,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
         const SolveStats st_r = S.residual(u.data(), r.data(), choice_rtol, b.data(), warm ? b.data() : nullptr);
         R.choice_fine_matvecs += S.apply_work(st_r.iterations);
         ContactConditions l = law;
-        if (opt.coulomb >= 0) l.set_coulomb_bound(opt.coulomb, lambda);
+        if (opt.friction.is_coulomb()) l.set_coulomb_bound(opt.friction.F, lambda);
         const ResidualNorms n = approximation_step(p, l.law(newton.kink_contact), nullptr, units.data(), u.data(),
                                                    lambda.data(), r.data(), v.data(), w.data(), d.data(), st.data());
         return std::sqrt(S.sum(n.consistent));
@@ -207,10 +192,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.newton.u.assign(3 * p, 0);
     R.newton.lambda.assign(p, 0);
     R.newton.status.assign(p, 0);
-  } else if (opt.coulomb >= 0 && opt.coulomb_method != RunOptions::CoulombMethod::fixed_point) {
-    R.coulomb = true;
-    newton.coulomb = opt.coulomb;
-    newton.coulomb_newton = opt.coulomb_method == RunOptions::CoulombMethod::newton;
+  } else if (opt.friction.bound_follows_lambda()) {
+    newton.friction = opt.friction;
     R.newton = semismooth_newton(S, law, newton);
     law.phi = R.newton.phi;
     R.coulomb_loop.iterations = 1;
@@ -218,10 +201,9 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.coulomb_loop.newton_steps = R.newton.iterations;
     R.coulomb_loop.inner_iterations = R.newton.inner_iterations;
     R.coulomb_loop.fine_matvecs = R.newton.fine_matvecs;
-  } else if (opt.coulomb >= 0) {
-    R.coulomb = true;
+  } else if (opt.friction.is_coulomb()) {
     CoulombOptions co;
-    co.F = opt.coulomb;
+    co.F = opt.friction.F;
     co.tol = opt.coulomb_tol;
     R.coulomb_loop = coulomb_fixed_point(S, law, co, newton);
     R.newton = std::move(R.coulomb_loop.last);
@@ -230,10 +212,10 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   } else {
     R.newton = semismooth_newton(S, law, newton);
   }
-  if (R.coulomb) {
+  if (R.coulomb()) {
     for (index i = 0; i < S.contact_nodes(); ++i)
       R.coulomb_consistency =
-          std::max(R.coulomb_consistency, std::abs(law.phi[i] - opt.coulomb * std::max(real(0), R.newton.lambda[i])));
+          std::max(R.coulomb_consistency, std::abs(law.phi[i] - opt.friction.F * std::max(real(0), R.newton.lambda[i])));
     R.coulomb_consistency = S.max(R.coulomb_consistency);
   }
   const double t3 = wall_time();
@@ -273,7 +255,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.times.solve = t3 - t2;
   R.times.recover = t4 - t3;
   R.times.total = t4 - t0;
-  const long long newton_inner = R.coulomb ? R.coulomb_loop.inner_iterations : R.newton.inner_iterations;
+  const long long newton_inner = R.coulomb() ? R.coulomb_loop.inner_iterations : R.newton.inner_iterations;
   R.inner_iterations = cond.iterations + newton_inner + R.report.inner.iterations;
   R.fine_matvecs_total = R.nested_fine_matvecs + R.newton_fine_matvecs() + S.apply_work(cond.iterations) +
                          S.apply_work(R.report.inner.iterations) + R.choice_fine_matvecs;
@@ -281,11 +263,11 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   // A failed Coulomb Newton solve is redone as the fixed point of Tresca
   // solves (each globalised by the line search), its work and time added to
   // the new run's
-  const bool coulomb_failed = R.coulomb && opt.coulomb_method != RunOptions::CoulombMethod::fixed_point &&
+  const bool coulomb_failed = R.coulomb() && opt.friction.method != FrictionLaw::CoulombMethod::fixed_point &&
                               (R.newton.reason == NewtonReason::stagnation || R.newton.reason == NewtonReason::iteration_limit);
   if (coulomb_failed) {
     RunOptions f = opt;
-    f.coulomb_method = RunOptions::CoulombMethod::fixed_point;
+    f.friction.method = FrictionLaw::CoulombMethod::fixed_point;
     if (opt.phase_done)
       opt.phase_done("Coulomb: one Newton solve did not converge; again by the fixed point", R.times.total);
     RunResult again = run_tresca(spec, f);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/contact/coulomb.hpp"
+#include "core/contact/friction.hpp"
 #include "core/contact/report.hpp"
 #include "core/contact/semismooth.hpp"
 #include "core/parallel/slab.hpp"
@@ -72,26 +73,13 @@ struct RunOptions {
   bool keep_interior_load = false;
   // the contact law per node (p values each); empty: contact_conditions(spec)
   ContactConditions contact;
-  // Coulomb friction (coulomb.hpp): coefficient F >= 0 makes the bound
-  // phi_i = F lambda_i (contact.phi / spec.phi are then not used); < 0: Tresca
-  real coulomb = -1;
+  // Tresca (the bounds of `contact` / spec.phi) or Coulomb (friction.hpp;
+  // contact.phi and spec.phi are then not used). If one Coulomb Newton solve
+  // fails, the fixed point takes over (run.cpp).
+  FrictionLaw friction;
   real coulomb_tol = 1e-6;  // the fixed point's stop on the relative change of phi (coarse meshes: nested_rtol)
-  // How, measured on levels 5-11 (perf/RESULTS.md §0e):
-  // - newton (default): one Newton solve whose step differentiates
-  //   phi = F lambda (NewtonOptions::coulomb_newton): 3 steps at F = 0.3,
-  //   4-5 at F = 0.8, 1.6-1.8x and 2.1-2.8x the Tresca work; converges at
-  //   F = 1.5 where the lagged bound oscillates;
-  // - lagged: one Newton solve with the bound a step late: 2x the Tresca
-  //   work at F = 0.3, 3.6-4x at F = 0.8;
-  // - fixed_point: whole Tresca solves (coulomb.hpp; 2.8x and 5.6-6.3x).
-  // If one Newton solve fails the fixed point takes over (run.cpp).
-  enum class CoulombMethod { lagged, fixed_point, newton } coulomb_method = CoulombMethod::newton;
 };
 
-const char* to_string(RunOptions::CoulombMethod m);  // "lagged", "newton", "fixed_point"
-// "lagged", "newton" or "fixed-point" (also "fixed_point"); throws
-// std::invalid_argument naming `option` otherwise
-RunOptions::CoulombMethod coulomb_method_from(const std::string& s, const std::string& option);
 
 struct RunTimes {
   double nested = 0;  // the coarser meshes' solves of nested iteration
@@ -103,17 +91,18 @@ struct RunResult {
   RunTimes times;
   NewtonResult newton;        // the (last) Tresca solve
   ContactConditions contact;  // the law used at each contact node (Coulomb: the last bound F lambda)
+  FrictionLaw friction;  // the run's (RunOptions::friction; the fixed point after a fallback)
+  bool coulomb() const { return friction.is_coulomb(); }
   // Coulomb: the fixed point's account (its `last` moved into newton)
-  bool coulomb = false;
   CoulombResult coulomb_loop;
   bool coulomb_fallback = false;  // one Newton solve failed; the fixed point took over
   real coulomb_consistency = 0;  // max_i |phi_i - F lambda_i| at the solution [N]
   // converged: Newton's test, the Coulomb fixed point's, and the final
   // check's KKT verdict (report.hpp) all say so
-  bool converged() const { return newton.converged() && (!coulomb || coulomb_loop.converged()) && report.kkt_ok; }
+  bool converged() const { return newton.converged() && (!coulomb() || coulomb_loop.converged()) && report.kkt_ok; }
   std::string reason() const {
     if (!newton.converged()) return to_string(newton.reason);
-    if (coulomb && !coulomb_loop.converged()) return to_string(coulomb_loop.reason);
+    if (coulomb() && !coulomb_loop.converged()) return to_string(coulomb_loop.reason);
     return report.kkt_ok ? "converged" : "kkt_check_failed";
   }
   FinalReport report;
@@ -135,8 +124,8 @@ struct RunResult {
   // the two residuals that decided it (included in fine_matvecs_total)
   std::string initial_iterate;
   double choice_fine_matvecs = 0;
-  long long newton_steps() const { return coulomb ? coulomb_loop.newton_steps : newton.iterations; }
-  double newton_fine_matvecs() const { return coulomb ? coulomb_loop.fine_matvecs : newton.fine_matvecs; }
+  long long newton_steps() const { return coulomb() ? coulomb_loop.newton_steps : newton.iterations; }
+  double newton_fine_matvecs() const { return coulomb() ? coulomb_loop.fine_matvecs : newton.fine_matvecs; }
   double fine_matvecs_per_newton_step() const {
     return newton_steps() > 0 ? newton_fine_matvecs() / double(newton_steps()) : 0;
   }

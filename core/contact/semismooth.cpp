@@ -84,9 +84,9 @@ struct ReducedSystem {
 // stay uncoupled.
 bool linearise(index p, const ContactConditions& law, const real* scale, const std::vector<real>& u,
                const std::vector<real>& lambda, const std::vector<std::uint8_t>& status, const std::vector<real>& vhat,
-               const std::vector<real>& d, real coulomb_F, ReducedSystem& L) {
+               const std::vector<real>& d, const FrictionLaw& friction, ReducedSystem& L) {
   bool any_known = false;
-  L.coupled = coulomb_F >= 0;
+  L.coupled = friction.differentiates_bound();
   for (index i = 0; i < p; ++i) {
     const bool stick = status[i] & kStick, contact = status[i] & kContact;
     const real s = scale ? scale[i] : 1;
@@ -110,7 +110,7 @@ bool linearise(index p, const ContactConditions& law, const real* scale, const s
     L.coupling[i] = L.coupling[p + i] = 0;
     if (L.coupled && !stick && contact) {
       const real n = std::hypot(d[i], d[p + i]);
-      const real tx = coulomb_F * d[i] / n, ty = coulomb_F * d[p + i] / n;
+      const real tx = friction.F * d[i] / n, ty = friction.F * d[p + i] / n;
       const real dl = -v3 - v4;  // the known part of λ_new − d_4
       L.rhs[i] -= tx * dl;
       L.rhs[p + i] -= ty * dl;
@@ -275,7 +275,9 @@ bool stagnated(const std::vector<real>& h, int w) {
 }
 
 NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt) {
-  // Coulomb (opt.coulomb >= 0): the bound follows lambda at every iteration
+  // Coulomb: the bound follows lambda at every iteration
+  if (opt.friction.is_coulomb() && !opt.friction.bound_follows_lambda())
+    throw std::invalid_argument("semismooth_newton: a Coulomb fixed point runs whole Tresca solves (coulomb.hpp)");
   ContactConditions law = given;
   const double t0 = wall_time();
   const index p = S.size() / 3, n3 = 3 * p, nf = S.full_size();
@@ -367,7 +369,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
   auto residual_at = [&](ContactConditions& at, const std::vector<real>& u, const std::vector<real>& lambda,
                          const std::vector<real>& r, std::vector<real>& vv, std::vector<real>& dd,
                          std::vector<std::uint8_t>& st) {
-    if (opt.coulomb >= 0) at.set_coulomb_bound(opt.coulomb, lambda);
+    if (opt.friction.bound_follows_lambda()) at.set_coulomb_bound(opt.friction.F, lambda);
     return approximation_step(p, at.law(opt.kink_contact), scale_ptr, units, u.data(), lambda.data(), r.data(),
                               vv.data(), trial.w.data(), dd.data(), st.data());
   };
@@ -396,10 +398,10 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
         const ResidualNorms norms = residual_at(law, R.u, R.lambda, R.r, v, d, R.status);
         merit = std::sqrt(S.sum(norms.consistent));
         vnorm = opt.stop == StopRule::consistent ? merit : std::sqrt(S.sum(norms.paper));
-        if (opt.coulomb >= 0 && opt.coulomb_newton) {
+        if (opt.friction.differentiates_bound()) {
           // the step's point on the Coulomb graph: its pressure d_4 sets the
           // bound of its friction force (v̂, the residual, stays at lambda)
-          for (index i = 0; i < p; ++i) law.phi[i] = opt.coulomb * d[2 * p + i];
+          for (index i = 0; i < p; ++i) law.phi[i] = opt.friction.F * d[2 * p + i];
           approximation_step(p, law.law(opt.kink_contact), scale_ptr, units, R.u.data(), R.lambda.data(), R.r.data(),
                              trial.v.data(), trial.w.data(), d.data(), R.status.data());
         }
@@ -455,7 +457,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
     // 2. linearisation: known increments, free set, H, right-hand side
     // (any rank's known increments make every rank apply S to them: S is collective)
     const bool any_known = S.max(linearise(p, law, scale_ptr, R.u, R.lambda, R.status, v, d,
-                                           opt.coulomb >= 0 && opt.coulomb_newton ? opt.coulomb : real(-1), L)
+                                           opt.friction, L)
                                      ? 1
                                      : 0) > 0;
 

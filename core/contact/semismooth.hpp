@@ -48,6 +48,7 @@
 #include <string>
 #include <vector>
 
+#include "core/contact/friction.hpp"
 #include "core/contact/steklov.hpp"
 #include "kernels/contact_maps.hpp"
 
@@ -148,17 +149,15 @@ struct NewtonOptions {
   // residual_accuracy, e.g. an earlier solve's NewtonResult::r and ::body
   const std::vector<real>* r0 = nullptr;
   real r0_accuracy = 0;  // r0's accuracy relative to force_scale (0: residual_accuracy)
-  // Coulomb with the bound lagged by one step: F >= 0 sets phi_i = F lambda_i
-  // of the current iterate before every approximation step (the law's phi is
-  // then ignored). ||v̂|| with that bound is the Coulomb problem's own
-  // residual, so the stopping rule stays; the Newton step does not
-  // differentiate phi (a quasi-Newton step, still symmetric). < 0: Tresca.
-  real coulomb = -1;
-  // with coulomb >= 0: the Newton step also differentiates phi_i = F lambda_i
-  // (a sliding node's friction force F lambda t moves with lambda): the
-  // semismooth* Newton step of the Coulomb problem itself, not symmetric, so
-  // solved by boundary GMRES with the same preconditioner (semismooth.cpp)
-  bool coulomb_newton = false;
+  // Tresca: the law's bounds phi. Coulomb lagged: phi_i = F lambda_i of the
+  // current iterate before every approximation step (the law's phi is then
+  // ignored); ||v̂|| with that bound is the Coulomb problem's own residual,
+  // so the stopping rule stays; the step does not differentiate phi (a
+  // quasi-Newton step, still symmetric). Coulomb newton: the step also
+  // differentiates phi (not symmetric: boundary GMRES with the same
+  // preconditioner, semismooth.cpp). A fixed point runs whole Tresca solves
+  // (coulomb.hpp) and is refused here.
+  FrictionLaw friction;
 };
 
 struct NewtonResult {

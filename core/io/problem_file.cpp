@@ -134,8 +134,9 @@ ProblemFile parse_problem(const std::string& text, const std::string& origin) {
     if (fr.contains("tresca") == fr.contains("coulomb")) r.fail("friction", "needs exactly one of 'tresca' and 'coulomb'");
     if (fr.contains("tresca")) s.phi = r.number(fr["tresca"], "friction.tresca");
     if (fr.contains("coulomb")) {
-      f.coulomb = r.number(fr["coulomb"], "friction.coulomb");
-      if (!(f.coulomb >= 0)) r.fail("friction.coulomb", "must be >= 0");
+      const real F = r.number(fr["coulomb"], "friction.coulomb");
+      if (!(F >= 0)) r.fail("friction.coulomb", "must be >= 0");
+      f.friction = coulomb_friction(F);
     }
   }
   if (j.contains("obstacle")) {
@@ -258,7 +259,7 @@ std::vector<real> read_gap_csv(const std::string& path, const GridDims& g) {
   return gap;
 }
 
-std::string problem_json(const ProblemSpec& s, real coulomb) {
+std::string problem_json(const ProblemSpec& s, const FrictionLaw& friction) {
   json j;
   j["mesh"] = json{{"dims", {s.ex, s.ey, s.ez}}};
   j["box"] = json{{"lengths", {s.lx, s.ly, s.lz}}, {"origin", {s.x0, s.y0, s.z0}}};
@@ -267,7 +268,7 @@ std::string problem_json(const ProblemSpec& s, real coulomb) {
   for (int f = 0; f < kLoadFaces; ++f)
     if (s.traction[f] != std::array<real, 3>{0, 0, 0}) t[load_face_name(f)] = s.traction[f];
   j["loads"] = json{{"traction", t}, {"body_force", s.body_force}, {"scale", s.load_scale}};
-  j["friction"] = coulomb >= 0 ? json{{"coulomb", coulomb}} : json{{"tresca", s.phi}};
+  j["friction"] = friction.is_coulomb() ? json{{"coulomb", friction.F}} : json{{"tresca", s.phi}};
   const Obstacle& o = s.obstacle;
   if (o.kind == Obstacle::Kind::plane)
     j["obstacle"] = json{{"kind", "plane"}, {"gap", o.gap}, {"slope", {o.slope_x, o.slope_y}}};

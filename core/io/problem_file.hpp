@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "core/contact/friction.hpp"
 #include "core/fem/problem.hpp"
 
 namespace tresca {
@@ -32,7 +33,7 @@ namespace tresca {
 struct ProblemFile {
   ProblemSpec spec;
   bool mesh_given = false;  // "mesh" present
-  real coulomb = -1;        // >= 0: Coulomb friction with this coefficient
+  FrictionLaw friction;     // Tresca (spec.phi) or Coulomb with a coefficient
 };
 
 // throws std::invalid_argument with a one-line message
@@ -49,6 +50,6 @@ std::vector<std::vector<real>> read_contact_csv(const std::string& path, const G
 // the gap per contact node (>= 0, metres) from the column `gap`
 std::vector<real> read_gap_csv(const std::string& path, const GridDims& g);
 // the problem in the file's schema, as JSON text (one line)
-std::string problem_json(const ProblemSpec& s, real coulomb);
+std::string problem_json(const ProblemSpec& s, const FrictionLaw& friction);
 
 }  // namespace tresca

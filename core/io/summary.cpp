@@ -38,10 +38,10 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
     obstacle["cy"] = o.cy;
   }
   Json coulomb = nullptr;
-  if (R.coulomb) {
+  if (R.coulomb()) {
     const CoulombResult& C = R.coulomb_loop;
-    coulomb = {{"F", opt.coulomb},
-               {"method", to_string(opt.coulomb_method)},
+    coulomb = {{"F", R.friction.F},
+               {"method", to_string(opt.friction.method)},
                {"fallback_to_fixed_point", R.coulomb_fallback},
                {"fixed_point_iterations", C.iterations},
                {"reason", to_string(C.reason)},
@@ -56,8 +56,8 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["nodes"] = P.nodes();
   j["contact_nodes"] = P.contact_nodes();
   j["dofs"] = P.free_dofs();
-  j["friction"] = R.coulomb ? "coulomb" : "tresca";
-  j["phi"] = R.coulomb ? Json(nullptr) : Json(spec.phi);
+  j["friction"] = R.coulomb() ? "coulomb" : "tresca";
+  j["phi"] = R.coulomb() ? Json(nullptr) : Json(spec.phi);
   j["gap"] = spec.obstacle.gap;
   j["obstacle"] = obstacle;
   j["load_scale"] = spec.load_scale;
@@ -113,7 +113,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
               {"stick_slip", F.stick_slip},           {"largest_in_newtons", F.kkt_force},
               {"residual_consistent", F.true_residual_consistent}, {"tolerance", F.tolerance},
               {"slip_unresolved", F.slip_unresolved}, {"ok", F.kkt_ok}};
-  j["problem"] = Json::parse(problem_json(spec, R.coulomb ? opt.coulomb : -1));
+  j["problem"] = Json::parse(problem_json(spec, R.friction));
   j["nested"] = nested;
   j["coulomb"] = coulomb;
   j["peak_memory_bytes"] = R.peak_memory;
