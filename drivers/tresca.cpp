@@ -111,6 +111,60 @@ PvdStep write_step(OutputSet& out, double time, const std::string& vtu, const Pr
 }
 }  // namespace
 
+// --table: the paper's levels one after another from x0 = 0 (its literal
+// method, set up in main), one row each beside the paper's figures; exit
+// status 0 if every level converged, 1 if not, 3 if an output failed
+static int run_table(const ProblemSpec& spec, const RunOptions& opt, const std::vector<int>& levels,
+                     const std::string& vtk_path, VtkFormat vtk_format, const std::string& json_path, int threads,
+                     bool quiet, const Comm& comm) {
+  for (int L : levels) check_memory(spec_for_level(L));
+  OutputSet out;  // the levels' VTU files and the collection, published with the JSON
+  std::vector<PvdStep> steps;
+  std::printf("%5s %9s %9s %9s %7s %9s %5s %5s | paper: %9s %9s %9s %5s | %s\n", "level", "n", "setup", "condense",
+              "p", "solve", "iters", "conv", "assembly", "schur", "solver", "iters", "true residual (rel)");
+  Json rows = Json::array();
+  bool all = true;
+  for (int L : levels) {
+    ProblemSpec s = spec_for_level(L);
+    s.phi = spec.phi;
+    s.E = spec.E;
+    s.nu = spec.nu;
+    RunOptions o = opt;
+    o.newton.progress = nullptr;
+    o.phase_done = nullptr;
+    o.recover_interior = !vtk_path.empty();
+    const RunResult R = run_tresca(s, o);
+    if (!vtk_path.empty()) {
+      const std::string v = vtu_step_name(vtk_path, "_level" + std::to_string(L));
+      const ContactFields cf{&R.newton.u, &R.newton.lambda, &R.report.r, &R.report.status, &R.contact.phi,
+                             &R.contact.gap};
+      steps.push_back(write_step(out, double(L), v, *R.problem, R.slab, R.u_full, cf, vtk_format));
+    }
+    const PaperRow* pr = paper_row(L);
+    char pbuf[128] = "        -         -         -     -";
+    if (pr) std::snprintf(pbuf, sizeof pbuf, "%9.3f %9.3f %9.3f %5d", pr->assembly, pr->schur, pr->solver, pr->iters);
+    std::printf("%5d %9lld %9.3f %9.3f %7lld %9.3f %5d %5s | paper: %s | %.2e (%.1e)\n", L,
+                (long long)R.problem->nodes(), R.times.setup, R.times.condense, (long long)R.problem->contact_nodes(),
+                R.times.solve, R.newton.iterations, R.converged() ? "yes" : "NO", pbuf,
+                R.report.true_residual, R.report.true_residual_relative);
+    std::fflush(stdout);
+    all = all && R.converged();
+    rows.push_back(run_summary(s, R, threads, opt));
+  }
+  try {
+    if (!json_path.empty()) write_text(out, json_path, json_text(rows));
+    if (!vtk_path.empty() && comm.rank() == 0) write_pvd(out, pvd_name(vtk_path), steps);
+    out.finish();
+    comm.barrier();  // every rank's pieces complete on disk before any is published
+    out.publish();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tresca: error: %s\n", e.what());
+    return 3;
+  }
+  if (!vtk_path.empty() && !quiet) std::printf("wrote %s (levels %d-%d)\n", pvd_name(vtk_path).c_str(), levels.front(), levels.back());
+  return all ? 0 : 1;
+}
+
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
   // Under mpirun with several ranks every rank runs this main: the 3D work is
@@ -284,55 +338,7 @@ int main(int argc, char** argv) {
                     (long long)p.sticking, (long long)p.sliding, p.inner_iterations, p.outer_iterations, p.elapsed);
         std::fflush(stdout);
       };
-    if (!table.empty()) {
-      const std::vector<int>& levels = table_levels;
-      for (int L : levels) check_memory(spec_for_level(L));
-      OutputSet out;  // the levels' VTU files and the collection, published with the JSON
-      std::vector<PvdStep> steps;
-      std::printf("%5s %9s %9s %9s %7s %9s %5s %5s | paper: %9s %9s %9s %5s | %s\n", "level", "n", "setup", "condense",
-                  "p", "solve", "iters", "conv", "assembly", "schur", "solver", "iters", "true residual (rel)");
-      Json rows = Json::array();
-      bool all = true;
-      for (int L : levels) {
-        ProblemSpec s = spec_for_level(L);
-        s.phi = spec.phi;
-        s.E = spec.E;
-        s.nu = spec.nu;
-        RunOptions o = opt;
-        o.newton.progress = nullptr;
-        o.phase_done = nullptr;
-        o.recover_interior = !vtk_path.empty();
-        const RunResult R = run_tresca(s, o);
-        if (!vtk_path.empty()) {
-          const std::string v = vtu_step_name(vtk_path, "_level" + std::to_string(L));
-          const ContactFields cf{&R.newton.u, &R.newton.lambda, &R.report.r, &R.report.status, &R.contact.phi,
-                                 &R.contact.gap};
-          steps.push_back(write_step(out, double(L), v, *R.problem, R.slab, R.u_full, cf, vtk_format));
-        }
-        const PaperRow* pr = paper_row(L);
-        char pbuf[128] = "        -         -         -     -";
-        if (pr) std::snprintf(pbuf, sizeof pbuf, "%9.3f %9.3f %9.3f %5d", pr->assembly, pr->schur, pr->solver, pr->iters);
-        std::printf("%5d %9lld %9.3f %9.3f %7lld %9.3f %5d %5s | paper: %s | %.2e (%.1e)\n", L,
-                    (long long)R.problem->nodes(), R.times.setup, R.times.condense, (long long)R.problem->contact_nodes(),
-                    R.times.solve, R.newton.iterations, R.converged() ? "yes" : "NO", pbuf,
-                    R.report.true_residual, R.report.true_residual_relative);
-        std::fflush(stdout);
-        all = all && R.converged();
-        rows.push_back(run_summary(s, R, threads, opt));
-      }
-      try {
-        if (!json_path.empty()) write_text(out, json_path, json_text(rows));
-        if (!vtk_path.empty() && comm.rank() == 0) write_pvd(out, pvd_name(vtk_path), steps);
-        out.finish();
-        comm.barrier();  // every rank's pieces complete on disk before any is published
-        out.publish();
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "tresca: error: %s\n", e.what());
-        return 3;
-      }
-      if (!vtk_path.empty() && !quiet) std::printf("wrote %s (levels %d-%d)\n", pvd_name(vtk_path).c_str(), levels.front(), levels.back());
-      return all ? 0 : 1;
-    }
+    if (!table.empty()) return run_table(spec, opt, table_levels, vtk_path, vtk_format, json_path, threads, quiet, comm);
 
     const ThreadPlacement placement = thread_placement();
     if (placement.cpus < int(placement.thread_cpus.size()))

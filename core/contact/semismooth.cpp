@@ -274,14 +274,11 @@ bool stagnated(const std::vector<real>& h, int w) {
   return last > 0.5 * before;
 }
 
-NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt) {
-  // Coulomb: the bound follows lambda at every iteration
-  if (opt.friction.is_coulomb() && !opt.friction.bound_follows_lambda())
-    throw std::invalid_argument("semismooth_newton: a Coulomb fixed point runs whole Tresca solves (coulomb.hpp)");
-  ContactConditions law = given;
-  const double t0 = wall_time();
-  const index p = S.size() / 3, n3 = 3 * p, nf = S.full_size();
-  auto size_error = [&](const char* what, size_t got, index want) {
+// the initial iterates' sizes, and every node's bound and gap: throws
+// std::invalid_argument naming what is wrong
+void check_inputs(index p, index nf, const ContactConditions& law, const NewtonOptions& opt) {
+  const index n3 = 3 * p;
+  auto size_error = [](const char* what, size_t got, index want) {
     throw std::invalid_argument(std::string("semismooth_newton: ") + what + " has " + std::to_string(got) +
                                 " entries, expected " + std::to_string(want));
   };
@@ -302,6 +299,59 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
       throw std::invalid_argument("semismooth_newton: gap of contact node " + std::to_string(i) + " = " +
                                   std::to_string(law.gap[i]) + " must be >= 0 and finite");
   }
+  if (opt.u0 && !(opt.force_scale > 0))
+    throw std::invalid_argument("semismooth_newton: an initial iterate u0 needs force_scale = |b~|");
+}
+
+// The forcing term of step k (Eisenstat–Walker, choice 2, safeguarded): the
+// step is solved to eta_k relative, eta_k -> 0 as |v̂| falls (superlinear),
+// but no finer than the stopping rule needs: a step that reduces |v̂| by
+// about tol/|v̂| is enough to stop after it (Kelley's safeguard against
+// oversolving the last step, with the factor 0.1: perf/RESULTS.md §0f)
+real forcing_term(const NewtonOptions& opt, int k, real vnorm, real previous, real eta, real tol) {
+  real eta_k = eta;
+  if (k > 0) {
+    const real ratio = vnorm / previous;
+    eta_k = std::min(opt.forcing_max, real(0.9) * ratio * ratio);
+    if (0.9 * eta * eta > 0.1) eta_k = std::max(eta_k, real(0.9) * eta * eta);
+  }
+  return std::min(opt.forcing_max, std::max(eta_k, real(0.1) * tol / vnorm));
+}
+
+// the progress of iteration k to the caller: states counted over all ranks
+void report_progress(const SteklovPoincare& S, const NewtonResult& R, const ContactConditions& law, int k, real vnorm,
+                     long long inner, double seconds, const std::function<void(const NewtonProgress&)>& progress) {
+  const StateCounts c = count_states(S.contact_nodes(), R.status.data());
+  NewtonProgress pr{k, vnorm, 0, 0, 0, 0, inner, R.outer_iterations, seconds,
+                    &R.u, &R.lambda, &R.r, &R.status, &law.phi};
+  pr.separated = index(S.sum(real(c.separated)));
+  pr.sticking = index(S.sum(real(c.stick)));
+  pr.sliding = index(S.sum(real(c.slip)));
+  pr.active = pr.sticking + pr.sliding;
+  pr.step_length = R.step_lengths.empty() ? 1 : R.step_lengths.back();
+  progress(pr);
+}
+
+// The non-monotone (GLL) backtracking line search: the first alpha = 2^-j,
+// j = 0 .. halvings, whose merit_at(alpha) <= (1 - 1e-4 alpha) times the
+// largest of the last memory + 1 merits; 0 if there is none
+real line_search(const std::vector<real>& merits, int memory, int halvings, const std::function<real(real)>& merit_at) {
+  const int m = std::min<int>(memory + 1, int(merits.size()));
+  const real reference = *std::max_element(merits.end() - m, merits.end());
+  real alpha = 1;
+  for (int j = 0; j <= halvings; ++j, alpha *= 0.5)
+    if (merit_at(alpha) <= (1 - 1e-4 * alpha) * reference) return alpha;
+  return 0;
+}
+
+NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt) {
+  // Coulomb: the bound follows lambda at every iteration
+  if (opt.friction.is_coulomb() && !opt.friction.bound_follows_lambda())
+    throw std::invalid_argument("semismooth_newton: a Coulomb fixed point runs whole Tresca solves (coulomb.hpp)");
+  ContactConditions law = given;
+  const double t0 = wall_time();
+  const index p = S.size() / 3, n3 = 3 * p, nf = S.full_size();
+  check_inputs(p, nf, law, opt);
   InnerWork work;
   NewtonResult R;
   R.u.assign(n3, 0);
@@ -336,8 +386,6 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
     R.operator_applications += 1;
     return work.residual(S, R.u.data(), R.r.data(), std::max(rtol, real(1e-12)), R.body.data(), R.body.data());
   };
-  if (opt.u0 && !(opt.force_scale > 0))
-    throw std::invalid_argument("semismooth_newton: an initial iterate u0 needs force_scale = |b~|");
   if (opt.r0) {
     R.r = *opt.r0;
   } else if (!refresh(opt.initial_residual_rtol)) {
@@ -407,21 +455,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
         }
       }
       tol = std::max(opt.eps, opt.rtol * (k == 0 ? vnorm : R.history[0]));
-      // Forcing term (Eisenstat–Walker, choice 2, safeguarded): the step is
-      // solved to eta_k relative, eta_k -> 0 as |v̂| falls (superlinear) ...
-      eta_k = eta;
-      if (k > 0) {
-        const real ratio = vnorm / R.history[k - 1];
-        eta_k = std::min(opt.forcing_max, real(0.9) * ratio * ratio);
-        if (0.9 * eta * eta > 0.1) eta_k = std::max(eta_k, real(0.9) * eta * eta);
-      }
-      // ... but no finer than the stopping rule needs: a step that reduces
-      // |v̂| by about tol/|v̂| is enough to stop after it (Kelley's safeguard
-      // against oversolving the last step, here with the factor 0.1: 0.5 left
-      // the 12x6x6 dense-reference case at 1.15e-6 > eps; measured: 16-21 %
-      // less Coulomb work at levels 8-11, where the last step's eta fell to
-      // 1e-8; Tresca the same)
-      eta_k = std::min(opt.forcing_max, std::max(eta_k, real(0.1) * tol / vnorm));
+      eta_k = forcing_term(opt, k, vnorm, k > 0 ? R.history[k - 1] : vnorm, eta, tol);
       // r must be accurate to a fraction of what the step resolves, and to
       // the full accuracy before |v̂| <= tol is believed
       const real need = vnorm <= tol ? opt.residual_accuracy * fscale
@@ -438,17 +472,7 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
     R.merit.push_back(merit);
     R.inner_history.push_back(work.iterations);
     R.outer_history.push_back(R.outer_iterations);
-    if (opt.progress) {
-      const StateCounts c = count_states(p, R.status.data());
-      NewtonProgress pr{k, vnorm, 0, 0, 0, 0, work.iterations, R.outer_iterations, wall_time() - t0,
-                        &R.u, &R.lambda, &R.r, &R.status, &law.phi};
-      pr.separated = index(S.sum(real(c.separated)));  // counts over all ranks
-      pr.sticking = index(S.sum(real(c.stick)));
-      pr.sliding = index(S.sum(real(c.slip)));
-      pr.active = pr.sticking + pr.sliding;
-      pr.step_length = R.step_lengths.empty() ? 1 : R.step_lengths.back();
-      opt.progress(pr);
-    }
+    if (opt.progress) report_progress(S, R, law, k, vnorm, work.iterations, wall_time() - t0, opt.progress);
     if (!std::isfinite(vnorm)) return finish(NewtonReason::non_finite);
     if (vnorm <= tol) return finish(NewtonReason::converged);
     if (k >= opt.max_iterations) return finish(NewtonReason::iteration_limit);
@@ -498,23 +522,17 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
     // (NewtonOptions::line_search); r, lambda and u are linear along it
     real alpha = 1;
     if (opt.line_search) {
-      const int m = std::min<int>(opt.line_search_memory + 1, int(R.merit.size()));
-      const real reference = *std::max_element(R.merit.end() - m, R.merit.end());
-      bool accepted = false;
-      for (int j = 0; j <= opt.line_search_halvings && !accepted; ++j) {
+      alpha = line_search(R.merit, opt.line_search_memory, opt.line_search_halvings, [&](real a) {
         for (index i = 0; i < n3; ++i) {
-          trial.u[i] = R.u[i] + alpha * du[i];
-          trial.r[i] = R.r[i] + alpha * Sdu[i];
+          trial.u[i] = R.u[i] + a * du[i];
+          trial.r[i] = R.r[i] + a * Sdu[i];
         }
-        for (index i = 0; i < p; ++i) trial.lambda[i] = R.lambda[i] + alpha * dlambda[i];
+        for (index i = 0; i < p; ++i) trial.lambda[i] = R.lambda[i] + a * dlambda[i];
         ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
-        const real m_trial =
-            std::sqrt(S.sum(residual_at(trial.law, trial.u, trial.lambda, trial.r, trial.v, trial.d, trial.status)
-                                .consistent));
-        accepted = m_trial <= (1 - 1e-4 * alpha) * reference;
-        if (!accepted) alpha *= 0.5;
-      }
-      if (!accepted) return finish(NewtonReason::stagnation);
+        return std::sqrt(
+            S.sum(residual_at(trial.law, trial.u, trial.lambda, trial.r, trial.v, trial.d, trial.status).consistent));
+      });
+      if (alpha == 0) return finish(NewtonReason::stagnation);
     }
     R.step_lengths.push_back(alpha);
     axpy(p, alpha, dlambda.data(), R.lambda.data());
