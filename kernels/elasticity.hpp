@@ -91,8 +91,8 @@ template <class T>
 void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_begin, index z_end,
                       const T* b = nullptr);
 // The same for a block of node rows: planes [z_begin, z_end) x rows
-// [y_begin, y_end), all of x (a rank's interior rows while its ghost rows
-// are in flight, core/parallel/distributed_elasticity.hpp).
+// [y_begin, y_end), all of x (a rank's owned rows, read with its ghost rows
+// as they are: core/fem/elasticity_operator.hpp).
 struct RowBlock {
   index z_begin, z_end, y_begin, y_end;
 };
