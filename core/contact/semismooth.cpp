@@ -231,9 +231,8 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
   co.reduction = &S.comm();  // contact vectors over the ranks (Comm::self() when not split)
   if (L.coupled) {
     // not symmetric: GMRES with the same preconditioner. The inner accuracy
-    // is fixed at 0.3 eta (0.1: 2-9 % more work, 1: a fifth Newton step at
-    // level 10, F = 0.8); relaxing it as the residual falls, as for CG, cost
-    // 1-2 more Newton steps (perf/RESULTS.md). S Δu is not a side product
+    // is fixed at 0.3 eta (tighter costs more work, looser and relaxing it as
+    // for CG cost Newton steps: perf/RESULTS.md §0e). S Δu is not a side product
     // here (the update's apply of S Δu bounds it by smax |Δu|)
     GMRESOptions go;
     go.atol = target;

@@ -110,8 +110,8 @@ GridDims grid_of(const ProblemSpec& spec);
 double estimated_memory_bytes(const ProblemSpec& s);
 // ... of one of `ranks` MPI ranks (core/parallel): its share of the
 // distributed fields plus what every rank holds whole (the load and one
-// temporary of 3n doubles). Measured at level 11 on 2 ranks: 0.50 GB per
-// rank against 0.59 estimated.
+// temporary of 3n doubles); held against the measured peak in
+// perf/RESULTS.md §0g.
 double estimated_memory_bytes_per_rank(const ProblemSpec& s, int ranks);
 
 }  // namespace tresca

@@ -40,15 +40,13 @@ void check_memory(const ProblemSpec& s);
 // with it set; a user's own setting is always kept. Call it first in main.
 // - OMP_WAIT_POLICY=passive with GOMP_SPINCOUNT=10000 where the cores were
 //   free at start (else 0): idle threads spin a few microseconds, then
-//   sleep. Measured (perf/RESULTS.md §0d): on an idle machine level 8 takes
-//   0.25-0.30 s instead of 0.37-0.48 s, level 10 1.4-1.7 s instead of
-//   1.9-2.1 s; with another process on a core spinning threads take its
-//   time (level 10: 4.0-4.6 s against 2.3-2.7 s sleeping), so a run that
-//   finds a core busy at start sleeps at once. Unless the user set either.
+//   sleep. Faster on an idle machine; with another process on a core,
+//   spinning threads take its time, so a run that finds a core busy at
+//   start sleeps at once (perf/RESULTS.md §0d). Unless the user set either.
 // - GLIBC_TUNABLES=glibc.malloc.hugetlb=1: malloc asks for transparent huge
-//   pages (where the kernel's THP mode is "madvise", as on Debian). First
-//   touch of the large arrays costs 512x fewer page faults: level 11 setup
-//   1.7 -> 0.7 s, the whole run 13.6 -> 9.9 s (perf/RESULTS.md §0d).
+//   pages (where the kernel's THP mode is "madvise", as on Debian): first
+//   touch of the large arrays costs 512x fewer page faults (the setup and
+//   the run it saves: perf/RESULTS.md §0d).
 // The drivers set these by re-executing themselves (the runtime reads them
 // before main), except where the user placed the threads (OMP_PROC_BIND,
 // OMP_PLACES, GOMP_CPU_AFFINITY) or the program runs under valgrind: libgomp

@@ -77,10 +77,9 @@ struct Array {
 };
 
 // VTK's compressed layout of one array: UInt64 header, then the blocks,
-// each an .xz stream (vtkLZMADataCompressor). LZMA, not zlib: at level 10
-// zlib level 1 made the body 4.0x smaller than ASCII, LZMA preset 1 8.4x
-// (the displacements: zlib 1.1x, LZMA 1.8x) for 0.3 s more on
-// 2 threads (perf/RESULTS.md). 1 MiB blocks, compressed in parallel.
+// each an .xz stream (vtkLZMADataCompressor). LZMA, not zlib: about twice
+// zlib's ratio on the body for a little more time (perf/RESULTS.md §0f).
+// 1 MiB blocks, compressed in parallel.
 constexpr size_t kBlock = size_t(1) << 20;
 constexpr std::uint32_t kLzmaPreset = 1;
 

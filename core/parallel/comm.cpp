@@ -38,7 +38,7 @@ bool launched_by_mpi() { return std::getenv("OMPI_COMM_WORLD_SIZE") || std::gete
 MpiSession::MpiSession(int& argc, char**& argv) {
 #ifdef TRESCA_HAVE_MPI
   // a plain run is one rank without MPI: Open MPI's singleton start-up
-  // (it spawns a daemon) would cost 0.4 s per run
+  // spawns a daemon, a fixed cost on every run
   if (!launched_by_mpi()) return;
   session_started = true;
   int provided = 0;
