@@ -55,7 +55,7 @@ int project(const Args& a) {
   const auto H = GridHierarchy::build(g, MGOptions{}.coarse_nodes);
   int px = 1, py = 1;
   rank_grid(g, ranks, px, py);
-  const CommVolume ap = apply_halo(g, px, py), it = mgcg_iteration(H->grids, px, py, MGOptions{}.degree);
+  const CommVolume ap = apply_halo(g, px, py), it = mgcg_iteration(H->grids(), px, py, MGOptions{}.degree);
   std::printf("level %d: mesh %s, %.3g dofs, %d ranks as %d x %d boxes, %.3g dofs per rank\n", spec.level,
               dims_string(spec).c_str(), double(spec.free_dofs()), ranks, px, py, double(spec.free_dofs()) / ranks);
   std::printf("network assumed: latency %.2g s, bandwidth %.3g GB/s per rank\n", net.latency, net.bandwidth / 1e9);
@@ -67,7 +67,7 @@ int project(const Args& a) {
   // a V-cycle of about (2 degree + 2) applies per level, weighted by size
   const double rate = a.real_value("--rate", 2.5e8), per_rank = double(spec.free_dofs()) / ranks;
   double cycle = 0;
-  for (const GridDims& l : H->grids) cycle += (2 * MGOptions{}.degree + 2) * double(l.nodes()) / double(g.nodes());
+  for (const GridDims& l : H->grids()) cycle += (2 * MGOptions{}.degree + 2) * double(l.nodes()) / double(g.nodes());
   const double t_apply = per_rank / rate, t_it = (1 + cycle) * t_apply;
   std::printf("compute at %.3g dof/s per rank: apply %.3g s, MG-CG iteration %.3g s (%.1f applies)\n", rate, t_apply,
               t_it, 1 + cycle);
@@ -77,7 +77,7 @@ int project(const Args& a) {
   // a Newton step with the counts measured at levels 10-12 (--outer per
   // step, --inner per S apply; perf/RESULTS.md §0g)
   const double outer = a.real_value("--outer", 3.5), inner = a.real_value("--inner", 6);
-  const CommVolume st = newton_step_comm(H->grids, px, py, MGOptions{}.degree, outer, inner);
+  const CommVolume st = newton_step_comm(H->grids(), px, py, MGOptions{}.degree, outer, inner);
   const double t_step = ((outer + 2) * (inner * (1 + cycle) + 2.0 / double(g.nz())) + outer * cycle) * t_apply;
   std::printf("Newton step (%.1f outer, %.0f inner per S apply): %.0f messages %10.4g bytes %.0f allreduces -> %.3g s "
               "against %.3g s of compute (%.1f %%)\n",

@@ -93,7 +93,7 @@ TEST(MultigridCG, HierarchyIsSharedAndTheOperatorComesFromItsDescription) {
   MGOptions mo;
   mo.coarse_nodes = 100;
   const auto grids = GridHierarchy::build(P.grid, mo.coarse_nodes);
-  ASSERT_GE(grids->grids.size(), 3u);
+  ASSERT_GE(grids->levels.size(), 3u);
   Multigrid a(grids, elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mo);
   Multigrid b(grids, elasticity_on(kFaceX0, 7e10, 0.33), mo);
   EXPECT_EQ(a.hierarchy().get(), b.hierarchy().get());

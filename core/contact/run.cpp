@@ -72,8 +72,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
       newton.lambda0 = &lambda0;
       // on the slab this mesh's operators will use (the whole grid on one rank)
       const Comm& comm = Comm::world();
-      const GridDims& g = R.problem->grid;
-      const Slab fine = worth_distributing(g, comm) ? make_slab(g, comm.rank(), comm.size()) : make_slab(g, 0, 1);
+      const Comm& split = split_over(R.problem->grid, comm);  // as SteklovPoincare's
+      const Slab fine = make_slab(R.problem->grid, split.rank(), split.size());
       const index n = 3 * fine.local.nodes();
       load_guess.resize(n);
       body.resize(n);

@@ -9,7 +9,7 @@
 namespace tresca {
 
 SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Comm& comm)
-    : P_(P), p_(P.contact_nodes()), comm_(worth_distributing(P.grid, comm) ? comm : Comm::self()), mg_opt_(mg) {
+    : P_(P), p_(P.contact_nodes()), comm_(split_over(P.grid, comm)), mg_opt_(mg) {
   const auto grids = GridHierarchy::build(P.grid, mg.coarse_nodes, comm_);
   K_ = ElasticityOperator(grids->levels[0].slab, P.dirichlet_faces, P.spec.E, P.spec.nu);
   mg_ = std::make_unique<Multigrid>(grids, elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mg);

@@ -101,29 +101,40 @@ bool worth_distributing(const GridDims& g, const Comm& comm, index min_nodes_per
   return P > 1 && g.ny() >= 2 * P && g.nodes() / P >= min_nodes_per_rank;
 }
 
+const Comm& split_over(const GridDims& g, const Comm& comm) {
+  return worth_distributing(g, comm) ? comm : Comm::self();
+}
+
 std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, index coarse_nodes, const Comm& comm,
                                                           index min_nodes_per_rank) {
   auto h = std::make_shared<GridHierarchy>();
   h->comm = &comm;
+  std::vector<GridDims> grids;
   GridDims g = fine;
   for (;;) {
-    h->grids.push_back(g);
+    grids.push_back(g);
     if (g.nodes() <= coarse_nodes || (g.ex == 1 && g.ey == 1 && g.ez == 1)) break;
     g = coarsen(g);
   }
   bool whole = false;  // once a level is whole, so are the coarser ones
-  for (size_t l = 0; l < h->grids.size(); ++l) {
+  for (size_t l = 0; l < grids.size(); ++l) {
     Level lv;
-    lv.grid = h->grids[l];
-    const bool coarsest = l + 1 == h->grids.size();  // solved by a factorisation
+    lv.grid = grids[l];
+    const bool coarsest = l + 1 == grids.size();  // solved by a factorisation
     whole = whole || coarsest || !worth_distributing(lv.grid, comm, min_nodes_per_rank);
     lv.distributed = !whole;
     lv.slab = lv.distributed ? make_slab(lv.grid, comm.rank(), comm.size()) : make_slab(lv.grid, 0, 1);
     h->levels.push_back(lv);
   }
   for (size_t l = 0; l + 1 < h->levels.size(); ++l)
-    h->to_coarse.push_back(make_link(build_transfer(h->grids[l], h->grids[l + 1]), h->levels[l], h->levels[l + 1], comm));
+    h->to_coarse.push_back(make_link(build_transfer(grids[l], grids[l + 1]), h->levels[l], h->levels[l + 1], comm));
   return h;
+}
+
+std::vector<GridDims> GridHierarchy::grids() const {
+  std::vector<GridDims> g;
+  for (const Level& lv : levels) g.push_back(lv.grid);
+  return g;
 }
 
 bool GridHierarchy::agglomerated(int l) const {
@@ -261,14 +272,14 @@ void Multigrid::factor_coarse() {
 }
 
 void Multigrid::set_bottom_block(const std::vector<real>& B) {
-  const GridDims& g0 = grids_->grids[0];
+  const GridDims& g0 = grids_->levels[0].grid;
   if (!B.empty() && index(B.size()) != 4 * g0.nx() * g0.ny())
     throw std::invalid_argument("multigrid: bottom block has " + std::to_string(B.size()) + " entries, expected 4 x " +
                                 std::to_string(g0.nx() * g0.ny()));
   std::vector<real> Bl = B;  // this level's, whole plane
   for (size_t l = 0; l < levels_.size(); ++l) {
     const ElasticityOperator& A = levels_[l].A;
-    zero_constrained_bottom_block(grids_->grids[l], A.global_faces(), Bl);
+    zero_constrained_bottom_block(grids_->levels[l].grid, A.global_faces(), Bl);
     levels_[l].A.set_bottom_block(Bl);
     if (l + 1 == levels_.size() || Bl.empty()) continue;
     Bl = project_bottom_block(grids_->to_coarse[l].whole, Bl);  // P^T B
@@ -379,8 +390,8 @@ void Multigrid::apply(const real* r, real* z) const {
 
 double Multigrid::cycle_work() const {
   double w = 0;
-  for (size_t l = 0; l + 1 < levels_.size(); ++l) w += double(grids_->grids[l].nodes());
-  return 2.0 * opt_.degree * w / double(grids_->grids[0].nodes());
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) w += double(grids_->levels[l].grid.nodes());
+  return 2.0 * opt_.degree * w / double(grids_->levels[0].grid.nodes());
 }
 
 std::string Multigrid::describe() const {

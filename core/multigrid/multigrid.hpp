@@ -74,6 +74,9 @@ struct MGOptions {
 // whether a grid is split over the ranks of comm: more than one rank, at
 // least 2 node rows and min_nodes_per_rank nodes per rank
 bool worth_distributing(const GridDims& g, const Comm& comm, index min_nodes_per_rank = 2048);
+// the ranks a fine grid's operators are split over: comm where
+// worth_distributing, else Comm::self() (every rank holds the grid whole)
+const Comm& split_over(const GridDims& g, const Comm& comm);
 
 // The grids of a multigrid hierarchy, how each is held by the ranks, and
 // the transfers between them.
@@ -91,13 +94,13 @@ struct GridHierarchy {
     // the coarse rows the fine rows interpolate from (null: none needed)
     std::shared_ptr<RowFetch> fetch_fine, fetch_coarse;
   };
-  std::vector<GridDims> grids;  // finest first
-  std::vector<Level> levels;
+  std::vector<Level> levels;  // finest first
   std::vector<Link> to_coarse;
   const Comm* comm = nullptr;
   // level l is the first whole level on several ranks: it and the coarser
   // ones are computed by rank 0 alone
   bool agglomerated(int l) const;
+  std::vector<GridDims> grids() const;  // the levels' whole grids
   int distributed_levels() const;
   // semi-coarsening until a grid has at most coarse_nodes nodes; levels
   // split over comm's ranks where worth_distributing (Comm::self(): all whole)
