@@ -1,18 +1,19 @@
 #include "boundary_block.hpp"
 
+#include "launch.hpp"
+
 namespace tresca {
 
 template <class T>
 void bottom_block_apply(const GridDims& g, T alpha, const T* B, const T* x, T* y) {
   const index M = g.nx() * g.ny(), N = g.nodes();
   const T *bxx = B, *bxy = B + M, *byy = B + 2 * M, *bzz = B + 3 * M;
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(M) * in_precision<T>(kBottomBlockCost)))
-  for (index n = 0; n < M; ++n) {
+  for_each_entry(M, in_precision<T>(kBottomBlockCost), [=](index n) {
     const T ux = x[n], uy = x[N + n], uz = x[2 * N + n];
     y[n] += alpha * (bxx[n] * ux + bxy[n] * uy);
     y[N + n] += alpha * (bxy[n] * ux + byy[n] * uy);
     y[2 * N + n] += alpha * bzz[n] * uz;
-  }
+  });
 }
 
 template void bottom_block_apply<double>(const GridDims&, double, const double*, const double*, double*);

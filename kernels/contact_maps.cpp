@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "launch.hpp"
 #include "vector_ops.hpp"
 
 namespace tresca {
@@ -39,8 +40,7 @@ ResidualNorms approximation_step(index p, const ContactLaw& law, const real* sca
   TRESCA_ASSERT(p >= 0 && (p == 0 || (law.phi != nullptr && law.gap != nullptr)));
   // per-node work in parallel, then the deterministic blocked sum of v.v.
   // (The test oracle is the dense reference Newton in tests/test_newton.cpp.)
-#pragma omp parallel for schedule(static) if (worth_threads(double(p) * kApproximationStepCost))
-  for (index i = 0; i < p; ++i) {
+  for_each_block(p, double(p) * kApproximationStepCost, [=](index i) {
     // x3 enters through F_4 = u_z + g
     const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + law.gap[i], x4 = lambda[i];
     const real r1 = r[i], r2 = r[p + i];
@@ -61,7 +61,7 @@ ResidualNorms approximation_step(index p, const ContactLaw& law, const real* sca
     d[p + i] = step.d2;
     d[2 * p + i] = step.d4;
     status[i] = std::uint8_t((step.contact ? kContact : 0) | (step.stick ? kStick : 0));
-  }
+  });
   return {dot(4 * p, v, v), dot(4 * p, w, w)};
 }
 

@@ -1,11 +1,11 @@
 #include "elasticity.hpp"
 
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "element.hpp"
+#include "launch.hpp"
 #include "simd.hpp"
 
 namespace tresca {
@@ -221,12 +221,11 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
   // the three input planes of the band (3 x (kBand+2) rows) stay in L2.
   constexpr index kBand = 16;
   const index rows_y = rows.y_end - rows.y_begin;
-  const index nthreads = omp_get_max_threads();
-  const index nbands = std::max<index>(1, nthreads * ((rows_y + nthreads * kBand - 1) / (nthreads * kBand)));
+  const index width = launch_width();
+  const index nbands = std::max<index>(1, width * ((rows_y + width * kBand - 1) / (width * kBand)));
   const index band = (rows_y + nbands - 1) / nbands;
   const double nodes = double(nx) * double(rows_y) * double(rows.z_end - rows.z_begin);
-#pragma omp parallel for schedule(static) if (worth_threads(nodes * in_precision<T>(kApplyCost)))
-  for (index bnd = 0; bnd < nbands; ++bnd)
+  for_each_block(nbands, nodes * in_precision<T>(kApplyCost), [&k, x, y, b, rows, nx, ny, N, nruns, band](index bnd) {
     for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
       for (index iy = rows.y_begin + bnd * band; iy < std::min(rows.y_end, rows.y_begin + (bnd + 1) * band); ++iy) {
         const std::uint8_t cy = k.cls[1][iy], cz = k.cls[2][iz];
@@ -247,6 +246,7 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
           stencil_range<T>(k.groups.data(), k.first.data() + 7 * s, x + row, y + row, b ? b + row : nullptr, N, i0, i1);
         }
       }
+  });
 }
 template void elasticity_apply<double>(const ElasticityStencilT<double>&, const double*, double*, const RowBlock&,
                                        const double*);
@@ -305,16 +305,15 @@ void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, in
 void elasticity_diagonal(const ElasticityStencil& k, real* d) {
   const GridDims& g = k.g;
   const index N = g.nodes();
-#pragma omp parallel for collapse(2) schedule(static) if (worth_threads(double(N) * kDiagonalCost))
-  for (index iz = 0; iz < g.nz(); ++iz)
-    for (index iy = 0; iy < g.ny(); ++iy)
-      for (index ix = 0; ix < g.nx(); ++ix) {
-        const std::uint8_t cx = k.cls[0][ix], cy = k.cls[1][iy], cz = k.cls[2][iz];
-        const index n = g.node(ix, iy, iz);
-        const bool fixed = (cx | cy | cz) & kSelf;
-        const std::int32_t s = fixed ? -1 : k.slot[(cx * 32 + cy) * 32 + cz];
-        for (int a = 0; a < 3; ++a) d[a * N + n] = fixed ? 1 : k.center[3 * s + a];
-      }
+  for_each_block(g.nz(), g.ny(), double(N) * kDiagonalCost, [&k, &g, d, N](index iz, index iy) {
+    for (index ix = 0; ix < g.nx(); ++ix) {
+      const std::uint8_t cx = k.cls[0][ix], cy = k.cls[1][iy], cz = k.cls[2][iz];
+      const index n = g.node(ix, iy, iz);
+      const bool fixed = (cx | cy | cz) & kSelf;
+      const std::int32_t s = fixed ? -1 : k.slot[(cx * 32 + cy) * 32 + cz];
+      for (int a = 0; a < 3; ++a) d[a * N + n] = fixed ? 1 : k.center[3 * s + a];
+    }
+  });
 }
 
 void elasticity_diagonal_ref(const ElasticityStencil& k, real* d) {

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "grid.hpp"
+#include "launch.hpp"
 #include "types.hpp"
 
 namespace tresca {
@@ -50,15 +51,15 @@ struct ElasticityStencilT {
   // per-axis class code of every node index: bit0 has-left-element,
   // bit1 has-right-element, bit2 left neighbour constrained, bit3 right
   // neighbour constrained, bit4 node itself on a constrained face of this axis
-  std::vector<std::uint8_t> cls[3];
+  Field<std::uint8_t> cls[3];
   // x-runs: maximal ranges of ix with the same x-class: [run_begin[r], run_begin[r+1])
-  std::vector<index> run_begin;
+  Field<index> run_begin;
   // stencils: id = slot[(cx*32 + cy)*32 + cz]; the groups of stencil s whose
   // nonzero outputs form mask m (1..7) are groups[first[7*s+m-1] .. first[7*s+m])
-  std::vector<std::int32_t> slot;
-  std::vector<std::int32_t> first;
-  std::vector<StencilGroupT<T>> groups;
-  std::vector<T> center;  // diagonal coefficient per stencil and component: center[3*s+a]
+  Field<std::int32_t> slot;
+  Field<std::int32_t> first;
+  Field<StencilGroupT<T>> groups;
+  Field<T> center;  // diagonal coefficient per stencil and component: center[3*s+a]
 
   index nodes() const { return g.nodes(); }
   index size() const { return 3 * g.nodes(); }

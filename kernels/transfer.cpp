@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "launch.hpp"
+
 namespace tresca {
 namespace {
 
@@ -84,30 +86,26 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
   const GridDims &f = t.fine, &c = t.coarse;
   const index Nf = f.nodes(), Nc = c.nodes(), cnx = c.nx(), cny = c.ny(), fnx = f.nx();
   const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
-#pragma omp parallel if (worth_threads(double(comps) * double(Nf) * in_precision<T>(kProlongateCost)))
-  {
-    std::vector<T> row(cnx);  // one buffer per thread, allocated once per call
-    T* s = row.data();
-#pragma omp for collapse(2) schedule(static)
-    for (index iz = 0; iz < f.nz(); ++iz)
-      for (index iy = 0; iy < f.ny(); ++iy) {
-        const index jz = Z.j0[iz], jy = Y.j0[iy];
-        const T wz = T(Z.w[iz]), wy = T(Y.w[iy]);
-        const T w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
-        const index b00 = cnx * (jy + cny * jz), b10 = b00 + cnx, b01 = b00 + cnx * cny, b11 = b01 + cnx;
-        for (int a = 0; a < comps; ++a) {
-          const T* u = coarse + a * Nc;
+  // one fine row (iy, iz); s: a coarse row of the worker's own
+  const auto fine_row = [&](index iz, index iy, T* s) {
+    const index jz = Z.j0[iz], jy = Y.j0[iy];
+    const T wz = T(Z.w[iz]), wy = T(Y.w[iy]);
+    const T w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
+    const index b00 = cnx * (jy + cny * jz), b10 = b00 + cnx, b01 = b00 + cnx * cny, b11 = b01 + cnx;
+    for (int a = 0; a < comps; ++a) {
+      const T* u = coarse + a * Nc;
 #pragma omp simd
-          for (index j = 0; j < cnx; ++j) s[j] = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
-          T* v = fine + a * Nf + fnx * (iy + f.ny() * iz);
-          for (index ix = 0; ix < fnx; ++ix) {
-            const index j = X.j0[ix];
-            const T wx = T(X.w[ix]);
-            v[ix] = (accumulate ? v[ix] : T(0)) + (1 - wx) * s[j] + wx * s[j + 1];
-          }
-        }
+      for (index j = 0; j < cnx; ++j) s[j] = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
+      T* v = fine + a * Nf + fnx * (iy + f.ny() * iz);
+      for (index ix = 0; ix < fnx; ++ix) {
+        const index j = X.j0[ix];
+        const T wx = T(X.w[ix]);
+        v[ix] = (accumulate ? v[ix] : T(0)) + (1 - wx) * s[j] + wx * s[j + 1];
       }
-  }
+    }
+  };
+  for_each_block_with_scratch<T>(f.nz(), f.ny(), cnx, double(comps) * double(Nf) * in_precision<T>(kProlongateCost),
+                                 fine_row);
 }
 
 template void prolongate<double>(const Transfer&, int, const double*, double*, bool);
@@ -141,30 +139,27 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) 
   const GridDims &f = t.fine, &c = t.coarse;
   const index Nf = f.nodes(), Nc = c.nodes(), fnx = f.nx();
   const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
-#pragma omp parallel if (worth_threads(double(comps) * double(Nf) * in_precision<T>(kRestrictCost)))
-  {
-    std::vector<T> row(fnx);  // one buffer per thread, allocated once per call
-#pragma omp for collapse(2) schedule(static)
-    for (index jz = 0; jz < c.nz(); ++jz)
-      for (index jy = 0; jy < c.ny(); ++jy)
-        for (int a = 0; a < comps; ++a) {
-          T* acc = row.data();
-          for (index i = 0; i < fnx; ++i) acc[i] = 0;
-          for (index kz = Z.tstart[jz]; kz < Z.tstart[jz + 1]; ++kz)
-            for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky) {
-              const T w = T(Z.tw[kz] * Y.tw[ky]);
-              const T* rr = fine + a * Nf + fnx * (Y.tf[ky] + f.ny() * Z.tf[kz]);
+  // one coarse row (jy, jz); acc: a fine row of the worker's own
+  const auto coarse_row = [&](index jz, index jy, T* acc) {
+    for (int a = 0; a < comps; ++a) {
+      for (index i = 0; i < fnx; ++i) acc[i] = 0;
+      for (index kz = Z.tstart[jz]; kz < Z.tstart[jz + 1]; ++kz)
+        for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky) {
+          const T w = T(Z.tw[kz] * Y.tw[ky]);
+          const T* rr = fine + a * Nf + fnx * (Y.tf[ky] + f.ny() * Z.tf[kz]);
 #pragma omp simd
-              for (index i = 0; i < fnx; ++i) acc[i] += w * rr[i];
-            }
-          T* out = coarse + a * Nc + c.nx() * (jy + c.ny() * jz);
-          for (index jx = 0; jx < c.nx(); ++jx) {
-            T sx = 0;
-            for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += T(X.tw[kx]) * acc[X.tf[kx]];
-            out[jx] = sx;
-          }
+          for (index i = 0; i < fnx; ++i) acc[i] += w * rr[i];
         }
-  }
+      T* out = coarse + a * Nc + c.nx() * (jy + c.ny() * jz);
+      for (index jx = 0; jx < c.nx(); ++jx) {
+        T sx = 0;
+        for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += T(X.tw[kx]) * acc[X.tf[kx]];
+        out[jx] = sx;
+      }
+    }
+  };
+  for_each_block_with_scratch<T>(c.nz(), c.ny(), fnx, double(comps) * double(Nf) * in_precision<T>(kRestrictCost),
+                                 coarse_row);
 }
 
 template void restrict_to_coarse<double>(const Transfer&, int, const double*, double*);

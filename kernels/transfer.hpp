@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "grid.hpp"
+#include "launch.hpp"
 #include "types.hpp"
 
 namespace tresca {
@@ -32,11 +33,11 @@ constexpr Cost kRestrictCost{10.4, 16};
 
 struct Interp1D {
   // fine node i interpolates from coarse j0[i] (weight 1-w[i]) and j0[i]+1 (weight w[i])
-  std::vector<index> j0;
-  std::vector<real> w;
+  Field<index> j0;
+  Field<real> w;
   // transpose lists: coarse j receives from fine tf[tstart[j]..tstart[j+1]) with weights tw
-  std::vector<index> tstart, tf;
-  std::vector<real> tw;
+  Field<index> tstart, tf;
+  Field<real> tw;
 };
 
 struct Transfer {

@@ -1,5 +1,6 @@
 #include "vector_ops.hpp"
 
+#include "launch.hpp"
 #include "simd.hpp"
 
 #include <algorithm>
@@ -8,30 +9,6 @@
 
 namespace tresca {
 
-namespace {
-// Sums block(i0, i1) over the fixed blocks [b*kDotBlock, (b+1)*kDotBlock) in
-// parallel, then adds the block sums serially: bitwise the same result for
-// any thread count. Each caller writes its block loop over plain pointers so
-// the compiler vectorises it with contiguous loads on every target (a per-
-// entry callback was vectorised with gathers and a spilled sum under AVX-512).
-template <class Block>
-real blocked_sum(index n, Cost per_entry, Block block) {
-  const index nb = (n + kDotBlock - 1) / kDotBlock;
-  constexpr index kStack = 256;
-  real stack[kStack];
-  std::vector<real> heap;
-  real* part = stack;
-  if (nb > kStack) {
-    heap.resize(nb);
-    part = heap.data();
-  }
-#pragma omp parallel for schedule(static) if (worth_threads(double(n) * per_entry))
-  for (index b = 0; b < nb; ++b) part[b] = block(b * kDotBlock, std::min(n, (b + 1) * kDotBlock));
-  real s = 0;
-  for (index b = 0; b < nb; ++b) s += part[b];
-  return s;
-}
-}  // namespace
 
 // Reductions use the target's vectors explicitly (simd.hpp): two independent
 // vector sums per block, a scalar tail. (GCC 12's `omp simd reduction` was
@@ -48,7 +25,7 @@ inline real hsum(V v) {
 }
 
 real dot(index n, const real* x, const real* y) {
-  return blocked_sum(n, kDotCost, [x, y](index i0, index i1) {
+  return sum_over_blocks(n, kDotBlock, kDotCost, [x, y](index i0, index i1) {
     V s0{}, s1{};
     index i = i0;
     for (; i + 2 * kL <= i1; i += 2 * kL) {
@@ -71,34 +48,28 @@ real dot_ref(index n, const real* x, const real* y) {
 real norm2(index n, const real* x) { return std::sqrt(dot(n, x, x)); }
 
 void axpy(index n, real a, const real* x, real* y) {
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * kAxpyCost))
-  for (index i = 0; i < n; ++i) y[i] += a * x[i];
+  for_each_entry(n, kAxpyCost, [=](index i) { y[i] += a * x[i]; });
 }
 void xpay(index n, const real* x, real a, real* y) {
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * kXpayCost))
-  for (index i = 0; i < n; ++i) y[i] = x[i] + a * y[i];
+  for_each_entry(n, kXpayCost, [=](index i) { y[i] = x[i] + a * y[i]; });
 }
 void copy(index n, const real* x, real* y) {
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * kCopyCost))
-  for (index i = 0; i < n; ++i) y[i] = x[i];
+  for_each_entry(n, kCopyCost, [=](index i) { y[i] = x[i]; });
 }
 template <class T>
 void fill(index n, T v, T* y) {
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * in_precision<T>(kFillCost)))
-  for (index i = 0; i < n; ++i) y[i] = v;
+  for_each_entry(n, in_precision<T>(kFillCost), [=](index i) { y[i] = v; });
 }
 void scale(index n, real a, real* y) {
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * kScaleCost))
-  for (index i = 0; i < n; ++i) y[i] *= a;
+  for_each_entry(n, kScaleCost, [=](index i) { y[i] *= a; });
 }
 void hadamard(index n, const real* d, const real* x, real* y) {
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * kHadamardCost))
-  for (index i = 0; i < n; ++i) y[i] = d[i] * x[i];
+  for_each_entry(n, kHadamardCost, [=](index i) { y[i] = d[i] * x[i]; });
 }
 
 real cg_update(index n, real a, const real* p, const real* q, real* x, real* r) {
   // fused in blocks so that r is still in cache (registers) when r.r is formed
-  return blocked_sum(n, kCgUpdateCost, [=](index i0, index i1) {
+  return sum_over_blocks(n, kDotBlock, kCgUpdateCost, [=](index i0, index i1) {
     V s0{};
     index i = i0;
     for (; i + kL <= i1; i += kL) {
@@ -127,23 +98,20 @@ real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real*
 
 template <class To, class From>
 void convert(index n, const From* x, To* y) {
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * Cost{double(sizeof(From) + sizeof(To)), 0}))
-  for (index i = 0; i < n; ++i) y[i] = To(x[i]);
+  for_each_entry(n, Cost{double(sizeof(From) + sizeof(To)), 0}, [=](index i) { y[i] = To(x[i]); });
 }
 
 template <class T>
 void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x) {
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * in_precision<T>(kChebUpdateCost)))
-  for (index i = 0; i < n; ++i) {
-    d[i] = s * d[i] + t * dinv[i] * r[i];
-    x[i] += d[i];
-  }
+  for_each_entry(n, in_precision<T>(kChebUpdateCost), [=](index i) {
+      d[i] = s * d[i] + t * dinv[i] * r[i];
+      x[i] += d[i];
+  });
 }
 
 template <class T>
 void cheb_first(index n, T t, const T* dinv, const T* b, T* d, T* x) {
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * in_precision<T>(kChebFirstCost)))
-  for (index i = 0; i < n; ++i) x[i] = d[i] = t * dinv[i] * b[i];
+  for_each_entry(n, in_precision<T>(kChebFirstCost), [=](index i) { x[i] = d[i] = t * dinv[i] * b[i]; });
 }
 
 template void fill<double>(index, double, double*);

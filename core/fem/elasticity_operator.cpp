@@ -35,7 +35,7 @@ const std::vector<double>& ElasticityOperator::block_in<double>() const {
   return B_;
 }
 template <>
-const std::vector<float>& ElasticityOperator::block_in<float>() const {
+const Field<float>& ElasticityOperator::block_in<float>() const {
   return Bf_;
 }
 
@@ -48,7 +48,7 @@ void ElasticityOperator::apply_rows(const T* x, T* y, const T* b, index z_begin,
     ScopedTimer t(Kernel::apply, nodes * in_precision<T>(b ? kResidualCost : kApplyCost));
     elasticity_apply<T>(stencil_in<T>(), x, y, RowBlock{z_begin, z_end, first, last}, b);
   }
-  const std::vector<T>& B = block_in<T>();
+  const Field<T>& B = block_in<T>();
   if (!B.empty() && z_begin == 0 && z_end > 0) {  // B is 0 on ghost rows
     const double m = double(g.nx()) * double(g.ny());
     ScopedTimer t(Kernel::apply_boundary, m * in_precision<T>(kBottomBlockCost));
@@ -93,8 +93,8 @@ void zero_constrained_bottom_block(const GridDims& g, unsigned faces, std::vecto
         for (int f = 0; f < 4; ++f) B[f * M + ix + g.nx() * iy] = 0;
 }
 
-std::vector<real> ElasticityOperator::diagonal() const {
-  std::vector<real> d(size());
+Field<real> ElasticityOperator::diagonal() const {
+  Field<real> d(size());
   elasticity_diagonal(k_, d.data());
   if (!B_.empty()) {
     const GridDims& g = slab_.local;

@@ -23,6 +23,7 @@
 #include "core/parallel/slab.hpp"
 #include "core/solvers/operator.hpp"
 #include "kernels/elasticity.hpp"
+#include "kernels/launch.hpp"
 
 namespace tresca {
 
@@ -65,16 +66,16 @@ class ElasticityOperator : public LinearOperator {
   // constrained nodes are ignored (set to zero); empty removes the term.
   void set_bottom_block(const std::vector<real>& B);
   // B on the local box's bottom plane (ghost rows 0); empty: none
-  const std::vector<real>& bottom_block() const { return B_; }
+  const Field<real>& bottom_block() const { return B_; }
 
   // diag(K + B) on the owned rows, 1 on constrained dofs, 0 on ghost rows
-  std::vector<real> diagonal() const;
+  Field<real> diagonal() const;
 
  private:
   template <class T>
   const ElasticityStencilT<T>& stencil_in() const;
   template <class T>
-  const std::vector<T>& block_in() const;
+  const Field<T>& block_in() const;
   // y = (K + B) x (or b - (K + B) x) on planes [z_begin, z_end) of the owned rows
   template <class T>
   void apply_rows(const T* x, T* y, const T* b, index z_begin, index z_end) const;
@@ -84,8 +85,8 @@ class ElasticityOperator : public LinearOperator {
   Halo halo_;
   ElasticityStencil k_;
   ElasticityStencilT<float> kf_;
-  std::vector<real> B_;
-  std::vector<float> Bf_;
+  Field<real> B_;
+  Field<float> Bf_;
 };
 
 // B (4 fields over the bottom plane of grid g) := 0 on the nodes of the
@@ -101,7 +102,7 @@ class JacobiPreconditioner : public LinearOperator {
   void apply(const real* r, real* z) const override;
 
  private:
-  std::vector<real> inv_;
+  Field<real> inv_;
 };
 
 }  // namespace tresca

@@ -14,7 +14,7 @@
 namespace tresca {
 
 struct InteriorSolution {
-  std::vector<real> u;             // 3N SoA on this rank's slab (ghost rows 0)
+  Field<real> u;             // 3N SoA on this rank's slab (ghost rows 0)
   SolveStats stats;
   double fine_matvecs = 0;         // work: per CG iteration one apply of K_ii and one V-cycle
   real relative_residual = 0;      // ||l_i - K_ii u|| / ||l_i||, recomputed

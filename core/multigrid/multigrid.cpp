@@ -226,7 +226,7 @@ template <class T>
 void Multigrid::refresh_work() {
   std::vector<Work<T>>& W = work<T>();
   for (size_t l = 0; l < levels_.size(); ++l) {
-    const std::vector<real> d = levels_[l].A.diagonal();
+    const Field<real> d = levels_[l].A.diagonal();
     W[l].dinv.resize(d.size());
     for (size_t i = 0; i < d.size(); ++i) W[l].dinv[i] = d[i] != 0 ? T(1 / d[i]) : T(0);  // ghost rows: 0
   }
@@ -236,7 +236,7 @@ void Multigrid::estimate_lmax(int l) {
   Level& lv = levels_[l];
   const GridHierarchy::Level& h = grids_->levels[l];
   const index n = lv.A.size();
-  std::vector<real> r(n), dinv = lv.A.diagonal();
+  Field<real> r(n), dinv = lv.A.diagonal();
   for (real& v : dinv) v = v != 0 ? 1 / v : 0;
   // the start vector by global dof index: runs of nx entries (one node row)
   const GridDims &box = h.slab.local, &G = h.grid;

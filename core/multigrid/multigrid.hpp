@@ -160,8 +160,8 @@ class Multigrid : public LinearOperator {
   // The V-cycle's vectors of one level in precision T.
   template <class T>
   struct Work {
-    std::vector<T> dinv;  // 1 / diag(K + B), 0 on ghost rows
-    mutable std::vector<T> x, b, r, d, fine_rows, coarse_rows;
+    Field<T> dinv;  // 1 / diag(K + B), 0 on ghost rows
+    mutable Field<T> x, b, r, d, fine_rows, coarse_rows;
     mutable T* xp = nullptr;  // iterate and right-hand side in use: the
     mutable const T* bp = nullptr;  // caller's arrays on a double level 0
   };

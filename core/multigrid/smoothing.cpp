@@ -10,7 +10,7 @@ real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const
                   std::vector<real> r, const Reduction* reduce) {
   // Lanczos through Jacobi-PCG: T_jj = 1/a_j + b_{j-1}/a_{j-1}, T_j,j+1 = sqrt(b_j)/a_j
   auto global = [&](real s) { return reduce ? reduce->sum(s) : s; };
-  std::vector<real> x(n, 0), z(n), p(n), q(n);
+  Field<real> x(n, 0), z(n), p(n), q(n);
   hadamard(n, dinv.data(), r.data(), z.data());
   copy(n, z.data(), p.data());
   real rz = global(dot(n, r.data(), z.data()));

@@ -10,6 +10,7 @@
 #include <functional>
 #include <vector>
 
+#include "kernels/launch.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/util/reduction.hpp"

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/solvers/operator.hpp"
+#include "kernels/launch.hpp"
 #include "core/util/reduction.hpp"
 
 namespace tresca {
@@ -51,7 +52,7 @@ struct CGOptions {
 
 // Work vectors kept by the caller so repeated solves do not allocate.
 struct CGWorkspace {
-  std::vector<real> r, z, p, q, s;
+  Field<real> r, z, p, q, s;
 };
 
 SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, real* x, const CGOptions& opt,

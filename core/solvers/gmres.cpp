@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "kernels/launch.hpp"
 #include "kernels/vector_ops.hpp"
 
 namespace tresca {
@@ -16,8 +17,9 @@ SolveStats gmres(const LinearOperator& A, const LinearOperator* M, const real* b
   if (opt.restart < 1 || opt.max_iterations < 0 || !(opt.rtol >= 0) || !(opt.atol >= 0))
     throw std::invalid_argument("gmres: restart must be >= 1, tolerances and max_iterations >= 0");
   const int m = opt.restart;
-  std::vector<std::vector<real>> V(m + 1, std::vector<real>(n)), Z(m, std::vector<real>(n));
-  std::vector<real> H((m + 1) * m), cs(m), sn(m), g(m + 1), y(m), w(n);
+  std::vector<Field<real>> V(m + 1, Field<real>(n)), Z(m, Field<real>(n));
+  std::vector<real> H((m + 1) * m), cs(m), sn(m), g(m + 1), y(m);
+  Field<real> w(n);
   auto h = [&](int i, int j) -> real& { return H[i * m + j]; };
 
   SolveStats st;

@@ -1,0 +1,98 @@
+// Where a kernel runs and where its vectors live: the one place that decides.
+//
+// Every kernel in kernels/ states its work as an index range, its modelled
+// Cost and a body (a lambda over plain pointers), and hands them to one of
+// the launchers below; no kernel starts threads itself. This is the seam of
+// the backends (in the spirit of a `parallel_for` over an index range):
+//
+//   - host (this file): OpenMP threads when the modelled work is worth it
+//     (worth_threads, types.hpp), schedule(static) so every sweep gives each
+//     thread the same entries, and so the pages it touched first;
+//   - the `_ref` twins are plain serial loops beside each kernel (the
+//     independent oracle of the tests, not a backend);
+//   - an offload backend is a second definition of these launchers (`omp
+//     target teams distribute parallel for simd` over the same bodies) and
+//     of Field, which then allocates where the device runs. Nothing above
+//     kernels/ names OpenMP's loop constructs.
+//
+// Field<T> is the storage of everything the linear machinery sweeps: the
+// operators' stencils and diagonals, every multigrid level's vectors, the
+// Krylov vectors. Code that owns such a vector declares it a Field.
+#pragma once
+#include "types.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <vector>
+
+namespace tresca {
+
+template <class T>
+using Field = std::vector<T>;
+
+// How many workers a launch has (threads on the host): a kernel that cuts
+// its range into cache-sized blocks makes at least one block per worker.
+inline index launch_width() { return omp_get_max_threads(); }
+
+// body(i) for every i in [0, n), independent entries vectorised across i.
+template <class Body>
+inline void for_each_entry(index n, Cost per_entry, const Body& body) {
+#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * per_entry))
+  for (index i = 0; i < n; ++i) body(i);
+}
+
+// body(b) for every block b in [0, n): independent blocks of work (rows,
+// bands of rows), each vectorised inside by its own body. `work` is the
+// whole launch's modelled cost.
+template <class Body>
+inline void for_each_block(index n, Cost work, const Body& body) {
+#pragma omp parallel for schedule(static) if (worth_threads(work))
+  for (index b = 0; b < n; ++b) body(b);
+}
+
+// body(j, i) for every block of an n1 x n0 range (j slow, i fast).
+template <class Body>
+inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
+#pragma omp parallel for collapse(2) schedule(static) if (worth_threads(work))
+  for (index j = 0; j < n1; ++j)
+    for (index i = 0; i < n0; ++i) body(j, i);
+}
+
+// The same, with `scratch` entries of T private to each worker for the
+// launch (allocated once per launch, not per block): body(j, i, scratch).
+template <class T, class Body>
+inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost work, const Body& body) {
+#pragma omp parallel if (worth_threads(work))
+  {
+    std::vector<T> buffer(scratch);
+    T* s = buffer.data();
+#pragma omp for collapse(2) schedule(static)
+    for (index j = 0; j < n1; ++j)
+      for (index i = 0; i < n0; ++i) body(j, i, s);
+  }
+}
+
+// Sum of block(i0, i1) over the fixed blocks [b*width, (b+1)*width) of
+// [0, n): the blocks in parallel, their sums added in order afterwards, so
+// the result is bitwise the same for any number of workers. Each caller's
+// block is a loop over plain pointers (vectorised with contiguous loads).
+template <class Block>
+inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& block) {
+  const index nb = (n + width - 1) / width;
+  constexpr index kStack = 256;
+  real stack[kStack];
+  std::vector<real> heap;
+  real* part = stack;
+  if (nb > kStack) {
+    heap.resize(nb);
+    part = heap.data();
+  }
+#pragma omp parallel for schedule(static) if (worth_threads(double(n) * per_entry))
+  for (index b = 0; b < nb; ++b) part[b] = block(b * width, std::min(n, (b + 1) * width));
+  real s = 0;
+  for (index b = 0; b < nb; ++b) s += part[b];
+  return s;
+}
+
+}  // namespace tresca
