@@ -65,7 +65,9 @@ const char* kHelp =
     "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
     "  --json FILE        write the run summary as one JSON object (rows with --table)\n"
     "  --contact-csv FILE one row per contact node\n"
-    "  --vtk FILE.vtu     deformed body for ParaView (+ FILE_contact.vtu); with --table one pair\n"
+    "  --vtk FILE.vtu     the body for ParaView: the undeformed mesh with the displacement u\n"
+    "                     (Warp By Vector shows it deformed), stress and von Mises per cell, and\n"
+    "                     FILE_contact.vtu, the contact face (docs/outputs.md); with --table one pair\n"
     "                     FILE_levelL.vtu, FILE_levelL_contact.vtu per level and FILE.pvd to play them\n"
     "  --vtk-every-iteration  with --vtk: also FILE_itK.vtu (+ _contact) at every Newton iterate K\n"
     "                     of the fine mesh and FILE.pvd to play them in ParaView (one extra S apply each)\n"
@@ -73,7 +75,7 @@ const char* kHelp =
     "  --table A-B        solve levels A..B and print the paper's Table 1 columns\n"
     "  --profile          per-kernel time, GB/s and GFLOP/s after the run\n"
     "  --quiet            no progress lines\n"
-    "  --help             this text\n"
+    "  -h, --help         this text;  --version  the version and the build (ISA, compiler)\n"
     "A run is converged only if its final KKT check agrees (else reason kkt_check_failed).\n"
     "Contact states, separation first: separated, stick (in contact), slip (in contact).\n"
     "Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure, 4 out of memory.\n";
@@ -111,59 +113,416 @@ PvdStep write_step(OutputSet& out, double time, const std::string& vtu, const Pr
 }
 }  // namespace
 
+namespace {
+
+// What the command line asks for, checked before any work.
+struct Command {
+  ProblemSpec spec;
+  RunOptions opt;
+  int threads = 1;
+  std::string json_path, csv_path, vtk_path, table;
+  std::vector<int> table_levels;
+  VtkFormat vtk_format = VtkFormat::binary;
+  bool every_iteration = false, quiet = false, profile = false;
+  std::vector<real> initial_u, initial_lambda;  // --initial: u0 (3p SoA), lambda0 (p)
+};
+
+// a failed write of an output: exit status 3
+struct OutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+void reject_with_table(const Args& a, const char* option, const char* why) {
+  if (a.has(option)) throw std::invalid_argument(std::string("--table ") + why + "; it takes no " + option);
+}
+
+// --initial F.csv: Newton's initial iterate from a --contact-csv file
+void read_initial_iterate(const Args& a, Command& c) {
+  const std::vector<std::vector<real>> f =
+      read_contact_csv(a.str("--initial"), grid_of(c.spec), {"ux", "uy", "uz", "lambda"}, "initial iterate");
+  c.initial_u = f[0];
+  c.initial_u.insert(c.initial_u.end(), f[1].begin(), f[1].end());
+  c.initial_u.insert(c.initial_u.end(), f[2].begin(), f[2].end());
+  c.initial_lambda = f[3];
+  c.opt.newton.u0 = &c.initial_u;
+  c.opt.newton.lambda0 = &c.initial_lambda;
+}
+
+// --eps, --max-newton, --outer-pc, --scaling (with --table: the paper's literal method)
+void newton_options_from(const Args& a, bool table, NewtonOptions& n) {
+  n.eps = a.real_value("--eps", 1e-6);
+  if (!(n.eps > 0)) throw std::invalid_argument("--eps " + a.str("--eps") + " must be > 0");
+  const long long mn = a.int_value("--max-newton", 50);
+  if (mn < 1 || mn > 100000) throw std::invalid_argument("--max-newton " + a.str("--max-newton") + " must be in 1..100000");
+  n.max_iterations = int(mn);
+  const std::string pc = a.str("--outer-pc", "mg");
+  if (pc != "mg" && pc != "none") throw std::invalid_argument("--outer-pc '" + pc + "' must be mg or none");
+  n.outer_pc = pc == "mg" ? OuterPreconditioner::multigrid : OuterPreconditioner::none;
+  const std::string sc = a.str("--scaling", table ? "paper" : "diagonal");
+  if (sc != "paper" && sc != "diagonal") throw std::invalid_argument("--scaling '" + sc + "' must be paper or diagonal");
+  if (sc != "paper") return;
+  const NewtonOptions paper = NewtonOptions::paper_method();
+  n.scaling = paper.scaling;
+  n.forcing_max = paper.forcing_max;
+  if (table) {  // the paper's literal method: its stopping rule, full steps, its kink rule
+    n.stop = paper.stop;
+    n.line_search = paper.line_search;
+    n.kink_contact = paper.kink_contact;
+  }
+}
+
+// --mg-precision, --mg-degree
+void multigrid_options_from(const Args& a, MGOptions& mg) {
+  const std::string prec = a.str("--mg-precision", "single");
+  if (prec != "single" && prec != "double")
+    throw std::invalid_argument("--mg-precision '" + prec + "' must be single or double");
+  mg.precision = prec == "single" ? Precision::single_precision : Precision::double_precision;
+  const long long degree = a.int_value("--mg-degree", mg.degree);
+  if (degree < 1 || degree > 8) throw std::invalid_argument("--mg-degree " + a.str("--mg-degree") + " must be in 1..8");
+  mg.degree = int(degree);
+}
+
+// --phi (Tresca, over a problem file's Coulomb), --coulomb F, --coulomb-method
+void friction_from(const Args& a, bool table, FrictionLaw& law) {
+  if (a.has("--phi")) law = tresca_friction();
+  law.method = coulomb_method_from(a.str("--coulomb-method", to_string(FrictionLaw{}.method)), "--coulomb-method");
+  if (!a.has("--coulomb")) return;
+  const real F = a.real_value("--coulomb", 0);
+  if (!(F >= 0) || !std::isfinite(F))
+    throw std::invalid_argument("--coulomb " + a.str("--coulomb") + " must be a friction coefficient >= 0");
+  law = coulomb_friction(F, law.method);
+  if (a.has("--phi")) throw std::invalid_argument("--coulomb and --phi exclude each other (Coulomb: phi_i = F lambda_i)");
+  if (table) throw std::invalid_argument("--table reproduces the paper's Tresca case; it takes no --coulomb");
+}
+
+// every output, the derived files included, writable and distinct before the solve
+void check_outputs(const Command& c, const Comm& comm) {
+  std::vector<std::pair<std::string, std::string>> outputs;  // (path, what)
+  if (!c.json_path.empty()) outputs.push_back({c.json_path, "--json"});
+  if (!c.csv_path.empty()) outputs.push_back({c.csv_path, "--contact-csv"});
+  const std::string& vtk = c.vtk_path;
+  if (!vtk.empty() && c.table.empty()) {
+    if (comm.distributed()) {  // ParaView's parallel format
+      outputs.push_back({path_stem(vtk) + ".pvtu", "--vtk's index"});
+      outputs.push_back({pvtu_piece_name(vtk, comm.rank()), "--vtk's piece"});
+    } else {
+      outputs.push_back({vtk, "--vtk"});
+    }
+    outputs.push_back({vtu_companion(vtk), "--vtk's contact file"});
+  }
+  if (c.every_iteration) {
+    outputs.push_back({pvd_name(vtk), "--vtk's collection"});
+    outputs.push_back({vtu_step_name(vtk, "_it0"), "--vtk's iterates"});
+  }
+  if (!vtk.empty() && !c.table.empty()) {
+    outputs.push_back({pvd_name(vtk), "--vtk's collection"});
+    for (int L : c.table_levels) {
+      const std::string v = vtu_step_name(vtk, "_level" + std::to_string(L));
+      outputs.push_back({v, "--vtk's level " + std::to_string(L)});
+      outputs.push_back({vtu_companion(v), "--vtk's level " + std::to_string(L) + " contact file"});
+    }
+  }
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    check_writable(outputs[i].first);
+    for (size_t j = 0; j < i; ++j)
+      if (same_file(outputs[i].first, outputs[j].first))
+        throw std::invalid_argument(outputs[i].second + " and " + outputs[j].second + " name the same file '" +
+                                    outputs[i].first + "'");
+  }
+}
+
+// The command line (and a problem file) into c (in place: its options point
+// at its own initial iterate); std::invalid_argument names what is wrong
+void parse_command(const Args& a, const Comm& comm, Command& c) {
+  c.threads = apply_threads(a);
+  c.table = a.str("--table");
+  const bool table = !c.table.empty();
+  if (table) {
+    for (const char* o : {"--level", "--dims", "--contact-csv"}) reject_with_table(a, o, "runs its own levels");
+    reject_with_table(a, "--problem", "reproduces the paper's problem");
+    reject_with_table(a, "--gap-file", "reproduces the paper's problem");
+    reject_with_table(a, "--initial", "starts every level from x0 = 0");
+  }
+  ProblemFile file;
+  if (a.has("--problem")) {
+    file = read_problem_file(a.str("--problem"));
+    c.opt.friction = file.friction;
+  }
+  c.spec = spec_from_args(a, 6, a.has("--problem") ? &file.spec : nullptr);
+  if (a.has("--gap-file")) {
+    if (a.has("--gap") || a.has("--obstacle")) throw std::invalid_argument("--gap-file excludes --gap and --obstacle");
+    c.opt.contact = contact_conditions(c.spec);
+    c.opt.contact.gap = read_gap_csv(a.str("--gap-file"), grid_of(c.spec));
+  }
+  if (a.has("--initial")) read_initial_iterate(a, c);
+  newton_options_from(a, table, c.opt.newton);
+  multigrid_options_from(a, c.opt.mg);
+  friction_from(a, table, c.opt.friction);
+  c.opt.nested = !a.has("--no-nested") && !table;  // --table: the paper's cold start
+  c.quiet = a.has("--quiet");
+  c.profile = a.has("--profile");
+  c.json_path = a.str("--json");
+  c.csv_path = a.str("--contact-csv");
+  c.vtk_path = a.str("--vtk");
+  if (a.has("--vtk-format") && c.vtk_path.empty())
+    throw std::invalid_argument("--vtk-format sets the encoding of --vtk's files; it needs --vtk FILE.vtu");
+  c.vtk_format = parse_vtk_format(a.str("--vtk-format", "binary"), "--vtk-format");
+  if (table) c.table_levels = parse_level_range(c.table);
+  c.every_iteration = a.has("--vtk-every-iteration");
+  if (c.every_iteration && (c.vtk_path.empty() || table))
+    throw std::invalid_argument("--vtk-every-iteration needs --vtk FILE.vtu (and no --table)");
+  check_outputs(c, comm);
+}
+
+// inputs that run but may not give what the user expects
+void warn_about(const Command& c) {
+  if (c.opt.newton.scaling == StepScaling::paper && (c.spec.E < 1e6 || c.spec.E > 1e12))
+    std::fprintf(stderr,
+                 "tresca: warning: --scaling paper adds forces [N] and displacements [m] as numbers, which suits the\n"
+                 "  paper's E = 2.1e9 Pa; at E = %g Pa they differ by many orders and Newton may stagnate\n"
+                 "  (--scaling diagonal, the default outside --table, does not depend on the units)\n",
+                 c.spec.E);
+  if (c.spec.nu > 0.49)
+    std::fprintf(stderr,
+                 "tresca: warning: nu = %g is nearly incompressible: Q1 elements lock and the multigrid inner solver "
+                 "degrades (it may fail to converge)\n",
+                 c.spec.nu);
+}
+
+// the progress lines of a run that is not --quiet
+void show_progress(RunOptions& opt) {
+  opt.phase_done = [](const char* phase, double sec) {
+    std::printf("  %s: %.2f s\n", phase, sec);
+    std::fflush(stdout);
+  };
+  opt.nested_done = [](const NestedLevel& l) {
+    std::printf("  nested: mesh %s solved in %d Newton steps%s: %.2f s\n", dims_string(l.spec).c_str(),
+                l.newton_iterations, l.converged ? "" : " (not converged: not used)", l.seconds);
+    std::fflush(stdout);
+  };
+  opt.newton.progress = [](const NewtonProgress& p) {
+    std::printf("  it %2d  |v| %10.3e  step %5.3f  contact %7lld  separated %7lld  stick %7lld  slip %7lld  inner %7lld  outer %5lld  %8.2f s\n",
+                p.iteration, p.residual, p.step_length, (long long)p.active, (long long)p.separated,
+                (long long)p.sticking, (long long)p.sliding, p.inner_iterations, p.outer_iterations, p.elapsed);
+    std::fflush(stdout);
+  };
+}
+
 // --table: the paper's levels one after another from x0 = 0 (its literal
-// method, set up in main), one row each beside the paper's figures; exit
-// status 0 if every level converged, 1 if not, 3 if an output failed
-static int run_table(const ProblemSpec& spec, const RunOptions& opt, const std::vector<int>& levels,
-                     const std::string& vtk_path, VtkFormat vtk_format, const std::string& json_path, int threads,
-                     bool quiet, const Comm& comm) {
-  for (int L : levels) check_memory(spec_for_level(L));
+// method, set up by parse_command), one row each beside the paper's
+// figures; exit status 0 if every level converged, 1 if not
+int run_table(const Command& c, const Comm& comm) {
+  for (int L : c.table_levels) check_memory(spec_for_level(L));
   OutputSet out;  // the levels' VTU files and the collection, published with the JSON
   std::vector<PvdStep> steps;
   std::printf("%5s %9s %9s %9s %7s %9s %5s %5s | paper: %9s %9s %9s %5s | %s\n", "level", "n", "setup", "condense",
               "p", "solve", "iters", "conv", "assembly", "schur", "solver", "iters", "true residual (rel)");
   Json rows = Json::array();
   bool all = true;
-  for (int L : levels) {
+  for (int L : c.table_levels) {
     ProblemSpec s = spec_for_level(L);
-    s.phi = spec.phi;
-    s.E = spec.E;
-    s.nu = spec.nu;
-    RunOptions o = opt;
+    s.phi = c.spec.phi;
+    s.E = c.spec.E;
+    s.nu = c.spec.nu;
+    RunOptions o = c.opt;
     o.newton.progress = nullptr;
     o.phase_done = nullptr;
-    o.recover_interior = !vtk_path.empty();
+    o.recover_interior = !c.vtk_path.empty();
+    profile_reset();  // each row's profile its own
     const RunResult R = run_tresca(s, o);
-    if (!vtk_path.empty()) {
-      const std::string v = vtu_step_name(vtk_path, "_level" + std::to_string(L));
+    if (!c.vtk_path.empty()) {
+      const std::string v = vtu_step_name(c.vtk_path, "_level" + std::to_string(L));
       const ContactFields cf{&R.newton.u, &R.newton.lambda, &R.report.r, &R.report.status, &R.contact.phi,
                              &R.contact.gap};
-      steps.push_back(write_step(out, double(L), v, *R.problem, R.slab, R.u_full, cf, vtk_format));
+      steps.push_back(write_step(out, double(L), v, *R.problem, R.slab, R.u_full, cf, c.vtk_format));
     }
     const PaperRow* pr = paper_row(L);
     char pbuf[128] = "        -         -         -     -";
     if (pr) std::snprintf(pbuf, sizeof pbuf, "%9.3f %9.3f %9.3f %5d", pr->assembly, pr->schur, pr->solver, pr->iters);
     std::printf("%5d %9lld %9.3f %9.3f %7lld %9.3f %5d %5s | paper: %s | %.2e (%.1e)\n", L,
                 (long long)R.problem->nodes(), R.times.setup, R.times.condense, (long long)R.problem->contact_nodes(),
-                R.times.solve, R.newton.iterations, R.converged() ? "yes" : "NO", pbuf,
-                R.report.true_residual, R.report.true_residual_relative);
+                R.times.solve, R.newton.iterations, R.converged() ? "yes" : "NO", pbuf, R.report.true_residual,
+                R.report.true_residual_relative);
     std::fflush(stdout);
     all = all && R.converged();
-    rows.push_back(run_summary(s, R, threads, opt));
+    rows.push_back(run_summary(s, R, c.threads, c.opt));
   }
   try {
-    if (!json_path.empty()) write_text(out, json_path, json_text(rows));
-    if (!vtk_path.empty() && comm.rank() == 0) write_pvd(out, pvd_name(vtk_path), steps);
+    if (!c.json_path.empty()) write_text(out, c.json_path, json_text(rows));
+    if (!c.vtk_path.empty() && comm.rank() == 0) write_pvd(out, pvd_name(c.vtk_path), steps);
     out.finish();
     comm.barrier();  // every rank's pieces complete on disk before any is published
     out.publish();
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "tresca: error: %s\n", e.what());
-    return 3;
+    throw OutputError(e.what());
   }
-  if (!vtk_path.empty() && !quiet) std::printf("wrote %s (levels %d-%d)\n", pvd_name(vtk_path).c_str(), levels.front(), levels.back());
+  if (!c.vtk_path.empty() && !c.quiet)
+    std::printf("wrote %s (levels %d-%d)\n", pvd_name(c.vtk_path).c_str(), c.table_levels.front(),
+                c.table_levels.back());
   return all ? 0 : 1;
 }
+
+// the run's first lines: the problem, the memory estimate, the build and where the threads run
+void print_header(const Command& c, const ThreadPlacement& placement, const Comm& comm) {
+  const ProblemSpec& spec = c.spec;
+  char friction[64];
+  if (c.opt.friction.is_coulomb())
+    std::snprintf(friction, sizeof friction, "Coulomb F %g", c.opt.friction.F);
+  else
+    std::snprintf(friction, sizeof friction, "phi %g", spec.phi);
+  std::printf("tresca: mesh %s (level %s), %lld nodes, %lld contact nodes, %lld dofs, %s, obstacle %s, eps %g, %d threads%s\n",
+              dims_string(spec).c_str(), spec.level >= 0 ? std::to_string(spec.level).c_str() : "-",
+              (long long)spec.nodes(), (long long)spec.contact_nodes(), (long long)spec.free_dofs(), friction,
+              to_string(spec.obstacle.kind), c.opt.newton.eps, c.threads,
+              comm.distributed() ? (" per rank x " + std::to_string(comm.size()) + " MPI ranks (y-slabs)").c_str() : "");
+  std::printf("        estimated peak memory %.2f GB%s; kernels: %s; %s\n",
+              estimated_memory_bytes_per_rank(spec, comm.size()) / 1e9, comm.distributed() ? " per rank" : "",
+              build_info().c_str(), omp_wait_setting().c_str());
+  std::printf("        %s\n", placement.describe().c_str());
+}
+
+// how the friction law's iteration ended (Coulomb)
+void print_coulomb(const Command& c, const RunResult& R) {
+  const CoulombResult& C = R.coulomb_loop;
+  if (R.coulomb_fallback)
+    std::printf("Coulomb F = %g: the Newton solve did not converge; the fixed point of Tresca solves took over\n",
+                R.friction.F);
+  if (c.opt.friction.bound_follows_lambda() && !R.coulomb_fallback) {
+    std::printf("Coulomb F = %g, the bound phi_i = F lambda_i %s at every Newton step; max |phi_i - F lambda_i| = %.2e N\n",
+                R.friction.F, c.opt.friction.differentiates_bound() ? "differentiated" : "updated",
+                R.coulomb_consistency);
+    return;
+  }
+  std::printf("Coulomb F = %g: %s after %d Tresca solves, %lld Newton steps in all (reason: %s); changes of phi:",
+              R.friction.F, C.converged() ? "converged" : "NOT CONVERGED", C.iterations, C.newton_steps,
+              to_string(C.reason));
+  for (real ch : C.changes) std::printf(" %.1e", ch);
+  std::printf("\nthe last Tresca solve (phi_i = F lambda_i of the one before, max |phi_i - F lambda_i| = %.2e N):\n",
+              R.coulomb_consistency);
+}
+
+// the run's report: convergence, the true residual, the KKT check, the contact sets, work and times
+void print_report(const Command& c, const RunResult& R, const Comm& comm) {
+  const NewtonResult& N = R.newton;
+  const FinalReport& F = R.report;
+  const real eps = c.opt.newton.eps;
+  char last[64] = "n/a (no approximation step)";
+  if (!N.history.empty()) std::snprintf(last, sizeof last, "%.3e", N.history.back());
+  if (R.coulomb()) print_coulomb(c, R);
+  std::printf("%s after %d Newton iterations (reason: %s), final |v| %s %s(tolerance %.1e)\n",
+              R.converged() ? "converged" : "NOT CONVERGED", N.iterations, R.reason().c_str(), last,
+              N.stop == StopRule::consistent ? "N " : "(the paper's rule) ", N.tolerance);
+  std::printf("true residual (fresh S u - b~): %.3e absolute, %.3e relative to |b| = %.3e\n", F.true_residual,
+              F.true_residual_relative, F.btilde_norm);
+  if (N.reason == NewtonReason::stagnation && !N.history.empty() && N.history.back() <= 1e-9 * N.history.front())
+    std::printf("note: |v| stagnated at %.1e of its initial value, the accuracy the inner solves attain: eps = %.1e\n"
+                "      is out of reach for this problem's magnitudes (--eps %.0e would be met)\n",
+                N.history.back() / N.history.front(), eps, std::pow(10.0, std::ceil(std::log10(2 * N.history.back()))));
+  if (N.converged() && !(F.true_residual <= eps))
+    std::printf("note: the true residual is above eps = %.1e = %.1e |b|, finer than the inner solves resolve (~1e-12 |b|)\n",
+                eps, eps / F.btilde_norm);
+  else if (N.converged() && F.resolution > eps)
+    std::printf("note: eps = %.1e is finer than the check resolves (the body's equilibrium to %.0e: r to ~%.1e N);\n"
+                "      the true residual is consistent with eps, not a proof of it\n",
+                eps, F.resolution / F.btilde_norm, F.resolution);
+  std::printf("KKT: equilibrium %.2e N, uz<0 %.2e m, lambda<0 %.2e N, lambda*uz %.2e Nm, |r_t|-phi %.2e N, direction %.2e N, stick slip %.2e m\n",
+              F.equilibrium, F.uz_violation, F.lambda_violation, F.complementarity, F.friction_bound,
+              F.friction_direction, F.stick_slip);
+  std::printf("KKT in consistent units: largest %.2e N, |w| %.2e N, tolerance %.2e N: %s", F.kkt_force,
+              F.true_residual_consistent, F.tolerance, F.kkt_ok ? "ok" : "FAILED");
+  if (F.slip_unresolved > 0)
+    std::printf(" (%lld sliding nodes slip less than the tolerance: direction not checked)", (long long)F.slip_unresolved);
+  std::printf("\n");
+  std::printf("contact: %lld active, %lld separated, %lld sticking, %lld sliding; min ux %.6e, max uz %.6e, sum lambda %.6e\n",
+              (long long)F.active, (long long)F.separated, (long long)F.sticking, (long long)F.sliding, F.ux_min,
+              F.uz_max, F.lambda_sum);
+  std::printf("work: %lld inner CG iterations, %lld outer CG iterations, %lld S applications\n", R.inner_iterations,
+              N.outer_iterations, N.operator_applications);
+  if (N.outer_limit_hits > 0)
+    std::printf("note: %d Newton steps were taken with an outer CG stopped at its iteration limit\n", N.outer_limit_hits);
+  std::printf("work: %.1f fine-grid matvec equivalents per Newton step; peak memory %.2f GB%s\n",
+              R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9, comm.distributed() ? " (largest rank)" : "");
+  std::printf("times [s]: nested %.3f, setup %.3f, condense %.3f, solve %.3f, recover %.3f, total %.3f\n",
+              R.times.nested, R.times.setup, R.times.condense, R.times.solve, R.times.recover, R.times.total);
+  if (comm.distributed()) {
+    const CommCounters& cc = comm_counters();
+    std::printf("communication (rank 0, whole run): %lld messages, %.1f MB point-to-point, %lld allreduces, "
+                "%lld other collectives\n", cc.messages, cc.bytes / 1e6, cc.allreduces, cc.collectives);
+  }
+  if (c.profile)
+    std::printf("\nkernel profile (%s, %d threads)\n%s", build_info().c_str(), c.threads,
+                profile_table(R.times.total).c_str());
+}
+
+// --vtk-every-iteration: each Newton iterate's files, into `out` and `steps`;
+// a failed write is kept in `error` (reported after the solve, exit 3)
+void write_iterates(const Command& c, RunOptions& opt, OutputSet& out, std::vector<PvdStep>& steps, std::string& error) {
+  opt.iterate_done = [&c, &out, &steps, &error](const Iterate& it) {
+    if (!error.empty()) return;
+    try {
+      const NewtonProgress& pr = *it.progress;
+      const ContactFields cf{pr.u, pr.lambda, pr.r, pr.status, pr.phi, it.gap};
+      const std::string v = vtu_step_name(c.vtk_path, "_it" + std::to_string(it.step));
+      steps.push_back(write_step(out, double(it.step), v, *it.problem, *it.slab, *it.u_full, cf, c.vtk_format));
+      out.finish();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  };
+}
+
+// all of the run's outputs, or none of them (output.hpp: OutputSet)
+void write_outputs(const Command& c, const RunResult& R, OutputSet& out, const std::vector<PvdStep>& steps,
+                   const std::string& iterate_error, const Comm& comm) {
+  try {
+    const NewtonResult& N = R.newton;
+    const ContactFields cf{&N.u, &N.lambda, &R.report.r, &R.report.status, &R.contact.phi, &R.contact.gap};
+    if (!iterate_error.empty()) throw std::runtime_error(iterate_error);
+    if (c.every_iteration && comm.rank() == 0) write_pvd(out, pvd_name(c.vtk_path), steps);
+    if (!c.json_path.empty()) write_text(out, c.json_path, json_text(run_summary(c.spec, R, c.threads, c.opt)));
+    if (!c.csv_path.empty()) write_contact_csv(out, c.csv_path, *R.problem, cf);
+    std::vector<std::string> wrote;
+    if (!c.vtk_path.empty()) wrote = write_step(out, 0, c.vtk_path, *R.problem, R.slab, R.u_full, cf, c.vtk_format).files;
+    out.finish();
+    comm.barrier();  // every rank's pieces complete on disk before any is published
+    out.publish();
+    if (!c.vtk_path.empty() && !c.quiet)
+      std::printf("wrote %s%s and %s\n", wrote[0].c_str(),
+                  R.slab.ranks > 1 ? (" (with " + std::to_string(R.slab.ranks) + " pieces " +
+                                      pvtu_piece_name(c.vtk_path, 0) + ", ...)").c_str()
+                                   : "",
+                  wrote[1].c_str());
+  } catch (const std::exception& e) {
+    throw OutputError(e.what());
+  }
+  // a full or closed stdout lost the report: not a success
+  if (std::fflush(stdout) != 0 || std::ferror(stdout))
+    throw OutputError("writing the report to standard output failed");
+}
+
+// one solve: header, progress, report, outputs; the exit status
+int run(Command& c, const Comm& comm) {
+  if (comm.rank() != 0) c.json_path = c.csv_path = "";  // outputs: rank 0's (and a piece of the VTU each)
+  warn_about(c);
+  if (!c.quiet) show_progress(c.opt);
+  if (!c.table.empty()) return run_table(c, comm);
+  const ThreadPlacement placement = thread_placement();
+  if (placement.cpus < int(placement.thread_cpus.size()))
+    std::fprintf(stderr, "tresca: warning: %d OpenMP threads may run on only %d CPUs (%s): they will share them\n",
+                 int(placement.thread_cpus.size()), placement.cpus, placement.describe().c_str());
+  if (!c.quiet) print_header(c, placement, comm);
+  OutputSet out;
+  std::vector<PvdStep> steps;
+  std::string iterate_error;
+  if (c.every_iteration) write_iterates(c, c.opt, out, steps, iterate_error);
+  const RunResult R = run_tresca(c.spec, c.opt);
+  print_report(c, R, comm);
+  write_outputs(c, R, out, steps, iterate_error, comm);
+  if (!R.converged()) std::fprintf(stderr, "tresca: not converged (%s)\n", R.reason().c_str());
+  return R.converged() ? 0 : 1;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
@@ -175,308 +534,28 @@ int main(int argc, char** argv) {
   if (comm.rank() != 0) {
     if (!std::freopen("/dev/null", "w", stdout) || !std::freopen("/dev/null", "w", stderr)) return 3;
   }
-  ProblemSpec spec;
-  RunOptions opt;
-  int threads = 1;
-  std::string json_path, csv_path, vtk_path, table;
-  std::vector<int> table_levels;
-  VtkFormat vtk_format = VtkFormat::binary;
-  bool every_iteration = false;
-  std::vector<real> initial_u, initial_lambda;  // --initial: u0 (3p SoA), lambda0 (p)
-  bool quiet = false, profile = false;
+  Command c;
   try {
     const Args a(argc, argv,
-                  {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
-                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--mg-degree", "--scaling", "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem", "--gap-file", "--vtk-format", "--initial"},
-                  {"--quiet", "--help", "--profile", "--no-nested", "--vtk-every-iteration"});
-    if (a.has("--help")) {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-    threads = apply_threads(a);
-    table = a.str("--table");
-    if (!table.empty() && (a.has("--level") || a.has("--dims") || a.has("--contact-csv")))
-      throw std::invalid_argument("--table runs its own levels; it takes no --level/--dims/--contact-csv");
-    ProblemFile file;
-    if (a.has("--problem")) {
-      if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's problem; it takes no --problem");
-      file = read_problem_file(a.str("--problem"));
-      if (!a.has("--phi")) opt.friction = file.friction;
-    }
-    spec = spec_from_args(a, 6, a.has("--problem") ? &file.spec : nullptr);
-    if (a.has("--gap-file")) {
-      if (a.has("--gap") || a.has("--obstacle"))
-        throw std::invalid_argument("--gap-file excludes --gap and --obstacle");
-      if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's problem; it takes no --gap-file");
-      opt.contact = contact_conditions(spec);
-      opt.contact.gap = read_gap_csv(a.str("--gap-file"), grid_of(spec));
-    }
-    if (a.has("--initial")) {
-      if (!table.empty()) throw std::invalid_argument("--table starts every level from x0 = 0; it takes no --initial");
-      const std::vector<std::vector<real>> c =
-          read_contact_csv(a.str("--initial"), grid_of(spec), {"ux", "uy", "uz", "lambda"}, "initial iterate");
-      initial_u = c[0];
-      initial_u.insert(initial_u.end(), c[1].begin(), c[1].end());
-      initial_u.insert(initial_u.end(), c[2].begin(), c[2].end());
-      initial_lambda = c[3];
-      opt.newton.u0 = &initial_u;
-      opt.newton.lambda0 = &initial_lambda;
-    }
-    opt.newton.eps = a.real_value("--eps", 1e-6);
-    if (!(opt.newton.eps > 0)) throw std::invalid_argument("--eps " + a.str("--eps") + " must be > 0");
-    const long long mn = a.int_value("--max-newton", 50);
-    if (mn < 1 || mn > 100000) throw std::invalid_argument("--max-newton " + a.str("--max-newton") + " must be in 1..100000");
-    opt.newton.max_iterations = int(mn);
-    const std::string pc = a.str("--outer-pc", "mg");
-    if (pc != "mg" && pc != "none") throw std::invalid_argument("--outer-pc '" + pc + "' must be mg or none");
-    opt.newton.outer_pc = pc == "mg" ? OuterPreconditioner::multigrid : OuterPreconditioner::none;
-    const std::string sc = a.str("--scaling", table.empty() ? "diagonal" : "paper");
-    if (sc != "paper" && sc != "diagonal") throw std::invalid_argument("--scaling '" + sc + "' must be paper or diagonal");
-    if (sc == "paper") {
-      const NewtonOptions paper = NewtonOptions::paper_method();
-      opt.newton.scaling = paper.scaling;
-      opt.newton.forcing_max = paper.forcing_max;
-      if (!table.empty()) {  // the paper's literal method: its stopping rule, full steps, its kink rule
-        opt.newton.stop = paper.stop;
-        opt.newton.line_search = paper.line_search;
-        opt.newton.kink_contact = paper.kink_contact;
-      }
-    }
-    const std::string prec = a.str("--mg-precision", "single");
-    if (prec != "single" && prec != "double")
-      throw std::invalid_argument("--mg-precision '" + prec + "' must be single or double");
-    opt.mg.precision = prec == "single" ? Precision::single_precision : Precision::double_precision;
-    const long long degree = a.int_value("--mg-degree", opt.mg.degree);
-    if (degree < 1 || degree > 8) throw std::invalid_argument("--mg-degree " + a.str("--mg-degree") + " must be in 1..8");
-    opt.mg.degree = int(degree);
-    if (a.has("--phi")) opt.friction = tresca_friction();  // the command line's Tresca bound over a file's Coulomb
-    opt.friction.method = coulomb_method_from(a.str("--coulomb-method", to_string(FrictionLaw{}.method)), "--coulomb-method");
-    if (a.has("--coulomb")) {
-      const real F = a.real_value("--coulomb", 0);
-      if (!(F >= 0) || !std::isfinite(F))
-        throw std::invalid_argument("--coulomb " + a.str("--coulomb") + " must be a friction coefficient >= 0");
-      opt.friction = coulomb_friction(F, opt.friction.method);
-      if (a.has("--phi")) throw std::invalid_argument("--coulomb and --phi exclude each other (Coulomb: phi_i = F lambda_i)");
-      if (!table.empty()) throw std::invalid_argument("--table reproduces the paper's Tresca case; it takes no --coulomb");
-    }
-    opt.nested = !a.has("--no-nested") && table.empty();  // --table: the paper's cold start
-    quiet = a.has("--quiet");
-    profile = a.has("--profile");
-    json_path = a.str("--json");
-    csv_path = a.str("--contact-csv");
-    vtk_path = a.str("--vtk");
-    vtk_format = parse_vtk_format(a.str("--vtk-format", "binary"), "--vtk-format");
-    if (!table.empty()) table_levels = parse_level_range(table);
-    // every output, the derived <stem>_contact.vtu included, checked before the solve
-    std::vector<std::pair<std::string, std::string>> outputs;  // (path, what)
-    if (!json_path.empty()) outputs.push_back({json_path, "--json"});
-    if (!csv_path.empty()) outputs.push_back({csv_path, "--contact-csv"});
-    if (!vtk_path.empty() && table.empty() && !comm.distributed()) {
-      outputs.push_back({vtk_path, "--vtk"});
-      outputs.push_back({vtu_companion(vtk_path), "--vtk's contact file"});
-    }
-    if (!vtk_path.empty() && table.empty() && comm.distributed()) {  // ParaView's parallel format
-      outputs.push_back({path_stem(vtk_path) + ".pvtu", "--vtk's index"});
-      outputs.push_back({pvtu_piece_name(vtk_path, comm.rank()), "--vtk's piece"});
-      outputs.push_back({vtu_companion(vtk_path), "--vtk's contact file"});
-    }
-    every_iteration = a.has("--vtk-every-iteration");
-    if (every_iteration && (vtk_path.empty() || !table.empty()))
-      throw std::invalid_argument("--vtk-every-iteration needs --vtk FILE.vtu (and no --table)");
-    if (every_iteration) {
-      outputs.push_back({pvd_name(vtk_path), "--vtk's collection"});
-      outputs.push_back({vtu_step_name(vtk_path, "_it0"), "--vtk's iterates"});
-    }
-    if (!vtk_path.empty() && !table.empty()) {
-      outputs.push_back({pvd_name(vtk_path), "--vtk's collection"});
-      for (int L : table_levels) {
-        const std::string v = vtu_step_name(vtk_path, "_level" + std::to_string(L));
-        outputs.push_back({v, "--vtk's level " + std::to_string(L)});
-        outputs.push_back({vtu_companion(v), "--vtk's level " + std::to_string(L) + " contact file"});
-      }
-    }
-    for (size_t i = 0; i < outputs.size(); ++i) {
-      check_writable(outputs[i].first);
-      for (size_t j = 0; j < i; ++j)
-        if (same_file(outputs[i].first, outputs[j].first))
-          throw std::invalid_argument(outputs[i].second + " and " + outputs[j].second + " name the same file '" +
-                                      outputs[i].first + "'");
-    }
+                 {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
+                  "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--mg-degree", "--scaling",
+                  "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem", "--gap-file",
+                  "--vtk-format", "--initial"},
+                 {"--quiet", "--profile", "--no-nested", "--vtk-every-iteration"});
+    if (answered_help_or_version(a, "tresca", kHelp)) return 0;
+    parse_command(a, comm, c);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());
     return 2;
   }
-  if (comm.rank() != 0) json_path = csv_path = "";  // outputs: rank 0's (and a piece of the VTU each)
-
-  if (opt.newton.scaling == StepScaling::paper && (spec.E < 1e6 || spec.E > 1e12))
-    std::fprintf(stderr,
-                 "tresca: warning: --scaling paper adds forces [N] and displacements [m] as numbers, which suits the\n"
-                 "  paper's E = 2.1e9 Pa; at E = %g Pa they differ by many orders and Newton may stagnate\n"
-                 "  (--scaling diagonal, the default outside --table, does not depend on the units)\n",
-                 spec.E);
-  if (spec.nu > 0.49)
-    std::fprintf(stderr,
-                 "tresca: warning: nu = %g is nearly incompressible: Q1 elements lock and the multigrid inner solver "
-                 "degrades (it may fail to converge)\n",
-                 spec.nu);
   try {
-    if (!quiet)
-      opt.phase_done = [](const char* phase, double sec) {
-        std::printf("  %s: %.2f s\n", phase, sec);
-        std::fflush(stdout);
-      };
-    if (!quiet)
-      opt.nested_done = [](const NestedLevel& l) {
-        std::printf("  nested: mesh %s solved in %d Newton steps%s: %.2f s\n", dims_string(l.spec).c_str(),
-                    l.newton_iterations, l.converged ? "" : " (not converged: not used)", l.seconds);
-        std::fflush(stdout);
-      };
-    if (!quiet)
-      opt.newton.progress = [](const NewtonProgress& p) {
-        std::printf("  it %2d  |v| %10.3e  step %5.3f  contact %7lld  separated %7lld  stick %7lld  slip %7lld  inner %7lld  outer %5lld  %8.2f s\n",
-                    p.iteration, p.residual, p.step_length, (long long)p.active, (long long)p.separated,
-                    (long long)p.sticking, (long long)p.sliding, p.inner_iterations, p.outer_iterations, p.elapsed);
-        std::fflush(stdout);
-      };
-    if (!table.empty()) return run_table(spec, opt, table_levels, vtk_path, vtk_format, json_path, threads, quiet, comm);
-
-    const ThreadPlacement placement = thread_placement();
-    if (placement.cpus < int(placement.thread_cpus.size()))
-      std::fprintf(stderr, "tresca: warning: %d OpenMP threads may run on only %d CPUs (%s): they will share them\n",
-                   int(placement.thread_cpus.size()), placement.cpus, placement.describe().c_str());
-    if (!quiet) {
-      char friction[64];
-      if (opt.friction.is_coulomb())
-        std::snprintf(friction, sizeof friction, "Coulomb F %g", opt.friction.F);
-      else
-        std::snprintf(friction, sizeof friction, "phi %g", spec.phi);
-      std::printf("tresca: mesh %s (level %s), %lld nodes, %lld contact nodes, %lld dofs, %s, obstacle %s, eps %g, %d threads%s\n",
-                  dims_string(spec).c_str(), spec.level >= 0 ? std::to_string(spec.level).c_str() : "-",
-                  (long long)spec.nodes(), (long long)spec.contact_nodes(), (long long)spec.free_dofs(), friction,
-                  to_string(spec.obstacle.kind), opt.newton.eps, threads,
-                  comm.distributed() ? (" per rank x " + std::to_string(comm.size()) + " MPI ranks (y-slabs)").c_str() : "");
-      std::printf("        estimated peak memory %.2f GB%s; kernels: %s; %s\n",
-                  estimated_memory_bytes_per_rank(spec, comm.size()) / 1e9, comm.distributed() ? " per rank" : "",
-                  build_info().c_str(), omp_wait_setting().c_str());
-      std::printf("        %s\n", placement.describe().c_str());
-    }
-    // --vtk-every-iteration: the iterates' files, published with the run's others
-    OutputSet out;
-    std::vector<PvdStep> steps;
-    std::string iterate_error;  // a failed write of an iterate: reported (exit 3) after the solve
-    if (every_iteration)
-      opt.iterate_done = [&](const Iterate& it) {
-        if (!iterate_error.empty()) return;
-        try {
-          const NewtonProgress& pr = *it.progress;
-          const ContactFields cf{pr.u, pr.lambda, pr.r, pr.status, pr.phi, it.gap};
-          const std::string v = vtu_step_name(vtk_path, "_it" + std::to_string(it.step));
-          steps.push_back(write_step(out, double(it.step), v, *it.problem, *it.slab, *it.u_full, cf, vtk_format));
-          out.finish();
-        } catch (const std::exception& e) {
-          iterate_error = e.what();
-        }
-      };
-    const RunResult R = run_tresca(spec, opt);
-    const NewtonResult& N = R.newton;
-    const FinalReport& F = R.report;
-    char last[64] = "n/a (no approximation step)";
-    if (!N.history.empty()) std::snprintf(last, sizeof last, "%.3e", N.history.back());
-    if (R.coulomb()) {
-      const CoulombResult& C = R.coulomb_loop;
-      if (R.coulomb_fallback)
-        std::printf("Coulomb F = %g: the Newton solve did not converge; the fixed point of Tresca solves took over\n",
-                    R.friction.F);
-      if (opt.friction.bound_follows_lambda() && !R.coulomb_fallback) {
-        std::printf("Coulomb F = %g, the bound phi_i = F lambda_i %s at every Newton step; max |phi_i - F lambda_i| = %.2e N\n",
-                    R.friction.F, opt.friction.differentiates_bound() ? "differentiated" : "updated",
-                    R.coulomb_consistency);
-      } else {
-        std::printf("Coulomb F = %g: %s after %d Tresca solves, %lld Newton steps in all (reason: %s); changes of phi:",
-                    R.friction.F, C.converged() ? "converged" : "NOT CONVERGED", C.iterations, C.newton_steps,
-                    to_string(C.reason));
-        for (real c : C.changes) std::printf(" %.1e", c);
-        std::printf("\nthe last Tresca solve (phi_i = F lambda_i of the one before, max |phi_i - F lambda_i| = %.2e N):\n",
-                    R.coulomb_consistency);
-      }
-    }
-    std::printf("%s after %d Newton iterations (reason: %s), final |v| %s %s(tolerance %.1e)\n",
-                R.converged() ? "converged" : "NOT CONVERGED", N.iterations, R.reason().c_str(), last,
-                N.stop == StopRule::consistent ? "N " : "(the paper's rule) ", N.tolerance);
-    std::printf("true residual (fresh S u - b~): %.3e absolute, %.3e relative to |b| = %.3e\n", F.true_residual,
-                F.true_residual_relative, F.btilde_norm);
-    if (N.reason == NewtonReason::stagnation && !N.history.empty() && N.history.back() <= 1e-9 * N.history.front())
-      std::printf("note: |v| stagnated at %.1e of its initial value, the accuracy the inner solves attain: eps = %.1e\n"
-                  "      is out of reach for this problem's magnitudes (--eps %.0e would be met)\n",
-                  N.history.back() / N.history.front(), opt.newton.eps,
-                  std::pow(10.0, std::ceil(std::log10(2 * N.history.back()))));
-    if (N.converged() && !(F.true_residual <= opt.newton.eps))
-      std::printf("note: the true residual is above eps = %.1e = %.1e |b|, finer than the inner solves resolve (~1e-12 |b|)\n",
-                  opt.newton.eps, opt.newton.eps / F.btilde_norm);
-    else if (N.converged() && F.resolution > opt.newton.eps)
-      std::printf("note: eps = %.1e is finer than the check resolves (the body's equilibrium to %.0e: r to ~%.1e N);\n"
-                  "      the true residual is consistent with eps, not a proof of it\n",
-                  opt.newton.eps, F.resolution / F.btilde_norm, F.resolution);
-    std::printf("KKT: equilibrium %.2e N, uz<0 %.2e m, lambda<0 %.2e N, lambda*uz %.2e Nm, |r_t|-phi %.2e N, direction %.2e N, stick slip %.2e m\n",
-                F.equilibrium, F.uz_violation, F.lambda_violation, F.complementarity, F.friction_bound,
-                F.friction_direction, F.stick_slip);
-    std::printf("KKT in consistent units: largest %.2e N, |w| %.2e N, tolerance %.2e N: %s", F.kkt_force,
-                F.true_residual_consistent, F.tolerance, F.kkt_ok ? "ok" : "FAILED");
-    if (F.slip_unresolved > 0)
-      std::printf(" (%lld sliding nodes slip less than the tolerance: direction not checked)",
-                  (long long)F.slip_unresolved);
-    std::printf("\n");
-    std::printf("contact: %lld active, %lld separated, %lld sticking, %lld sliding; min ux %.6e, max uz %.6e, sum lambda %.6e\n",
-                (long long)F.active, (long long)F.separated, (long long)F.sticking, (long long)F.sliding, F.ux_min,
-                F.uz_max, F.lambda_sum);
-    std::printf("work: %lld inner CG iterations, %lld outer CG iterations, %lld S applications\n", R.inner_iterations,
-                N.outer_iterations, N.operator_applications);
-    if (N.outer_limit_hits > 0)
-      std::printf("note: %d Newton steps were taken with an outer CG stopped at its iteration limit\n",
-                  N.outer_limit_hits);
-    std::printf("work: %.1f fine-grid matvec equivalents per Newton step; peak memory %.2f GB%s\n",
-                R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9, comm.distributed() ? " (largest rank)" : "");
-    std::printf("times [s]: nested %.3f, setup %.3f, condense %.3f, solve %.3f, recover %.3f, total %.3f\n",
-                R.times.nested, R.times.setup, R.times.condense, R.times.solve, R.times.recover, R.times.total);
-    if (comm.distributed()) {
-      const CommCounters& c = comm_counters();
-      std::printf("communication (rank 0, whole run): %lld messages, %.1f MB point-to-point, %lld allreduces, "
-                  "%lld other collectives\n", c.messages, c.bytes / 1e6, c.allreduces, c.collectives);
-    }
-    if (profile) std::printf("\nkernel profile (%s, %d threads)\n%s", build_info().c_str(), threads,
-                             profile_table(R.times.total).c_str());
-    try {
-      const ContactFields cf{&N.u, &N.lambda, &F.r, &F.status, &R.contact.phi, &R.contact.gap};
-      // all of the run's outputs, or none of them (output.hpp: OutputSet)
-      if (!iterate_error.empty()) throw std::runtime_error(iterate_error);
-      if (every_iteration && comm.rank() == 0) write_pvd(out, pvd_name(vtk_path), steps);
-      if (!json_path.empty()) write_text(out, json_path, json_text(run_summary(spec, R, threads, opt)));
-      if (!csv_path.empty()) write_contact_csv(out, csv_path, *R.problem, cf);
-      std::vector<std::string> wrote;
-      if (!vtk_path.empty()) wrote = write_step(out, 0, vtk_path, *R.problem, R.slab, R.u_full, cf, vtk_format).files;
-      out.finish();
-      comm.barrier();  // every rank's pieces complete on disk before any is published
-      out.publish();
-      if (!vtk_path.empty() && !quiet)
-        std::printf("wrote %s%s and %s\n", wrote[0].c_str(),
-                    R.slab.ranks > 1 ? (" (with " + std::to_string(R.slab.ranks) + " pieces " +
-                                        pvtu_piece_name(vtk_path, 0) + ", ...)").c_str()
-                                     : "",
-                    wrote[1].c_str());
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "tresca: error: %s\n", e.what());
-      return 3;
-    }
-    // a full or closed stdout lost the report: not a success
-    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
-      std::fprintf(stderr, "tresca: error: writing the report to standard output failed\n");
-      return 3;
-    }
-    if (!R.converged()) std::fprintf(stderr, "tresca: not converged (%s)\n", R.reason().c_str());
-    return R.converged() ? 0 : 1;
+    return run(c, comm);
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());
     return 2;
+  } catch (const OutputError& e) {
+    std::fprintf(stderr, "tresca: error: %s\n", e.what());
+    return 3;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "tresca: error: out of memory (the estimate is printed first; try a smaller mesh)\n");
     return 4;

@@ -89,8 +89,7 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
                           index i0, index i1) {
   constexpr int kLanes = Simd<T>::lanes;
   // three vectors per block: 9 accumulators + 3 inputs fit the 16 registers of
-  // SSE/AVX2 (and AVX-512's 32); measured best of 1..4 on AVX-512, AVX2 and
-  // SSE4.2 builds alike (perf/RESULTS.md)
+  // SSE/AVX2 (and AVX-512's 32); the width is measured (perf/RESULTS.md §0i)
   constexpr int kW = 3 * kLanes;
   index i = i0;
   for (; i + kW <= i1; i += kW) stencil_block<T, kW>(g, f, x, y, b, N, i);

@@ -62,4 +62,26 @@ void brick_stiffness(real hx, real hy, real hz, real E, real nu, real* Ke) {
   }
 }
 
+void centroid_stress(real hx, real hy, real hz, real E, real nu, const real* ue, real* s) {
+  // g[a][d] = d u_a / d x_d at the centroid
+  real g[3][3] = {};
+  const real h[3] = {hx, hy, hz};
+  for (int L = 0; L < 8; ++L)
+    for (int d = 0; d < 3; ++d) {
+      const real sign = ((L >> d) & 1) ? 1 : -1;
+      for (int a = 0; a < 3; ++a) g[a][d] += sign * ue[3 * L + a] / (4 * h[d]);
+    }
+  const Lame m = lame_from(E, nu);
+  const real tr = g[0][0] + g[1][1] + g[2][2];
+  for (int a = 0; a < 3; ++a) s[a] = m.lambda * tr + 2 * m.mu * g[a][a];
+  s[3] = m.mu * (g[0][1] + g[1][0]);
+  s[4] = m.mu * (g[1][2] + g[2][1]);
+  s[5] = m.mu * (g[0][2] + g[2][0]);
+}
+
+real von_mises(const real* s) {
+  const real dxy = s[0] - s[1], dyz = s[1] - s[2], dzx = s[2] - s[0];
+  return std::sqrt(0.5 * (dxy * dxy + dyz * dyz + dzx * dzx) + 3 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]));
+}
+
 }  // namespace tresca

@@ -21,4 +21,12 @@ Lame lame_from(real E, real nu);
 // Writes the 576 entries of Ke.
 void brick_stiffness(real hx, real hy, real hz, real E, real nu, real* Ke);
 
+// Cauchy stress at the brick's centroid from its 24 nodal displacements ue
+// (layout above): s = D B(0) ue in VTK's order of a symmetric tensor,
+// xx, yy, zz, xy, yz, xz [Pa]. At the centroid du/dx is the mean of the four
+// x-edge differences over hx (likewise y, z): exact for the Q1 field there.
+void centroid_stress(real hx, real hy, real hz, real E, real nu, const real* ue, real* s);
+// von Mises equivalent stress of s (the order above)
+real von_mises(const real* s);
+
 }  // namespace tresca

@@ -11,9 +11,8 @@ namespace tresca {
 
 
 // Reductions use the target's vectors explicitly (simd.hpp): two independent
-// vector sums per block, a scalar tail. (GCC 12's `omp simd reduction` was
-// vectorised with gathers and a sum spilled to the stack every iteration
-// under -march=native on AVX-512: 4x slower than the AVX2 build.)
+// vector sums per block, a scalar tail. (GCC 12 vectorised `omp simd
+// reduction` badly under -march=native on AVX-512: perf/RESULTS.md §0i.)
 using V = Vec<real>;
 constexpr index kL = Simd<real>::lanes;
 inline V load(const real* p) { return *reinterpret_cast<const V*>(p); }

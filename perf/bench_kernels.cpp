@@ -5,7 +5,11 @@
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
+#include <cstdio>
+#include <cstring>
 #include <vector>
+
+#include "core/io/cli.hpp"
 
 #include "core/multigrid/multigrid.hpp"
 #include "core/fem/problem.hpp"
@@ -27,7 +31,8 @@ void set_rates(benchmark::State& st, double dofs, double bytes_per_dof, double f
   st.counters["DoF/s"] = benchmark::Counter(dofs * it, benchmark::Counter::kIsRate);
   st.counters["bytes/s"] = benchmark::Counter(dofs * bytes_per_dof * it, benchmark::Counter::kIsRate);
   st.counters["FLOP/s"] = benchmark::Counter(dofs * flops_per_dof * it, benchmark::Counter::kIsRate);
-  st.counters["threads"] = omp_get_max_threads();
+  // (not "threads": Google Benchmark's own key of every run, the benchmark's threads)
+  st.counters["omp_threads"] = omp_get_max_threads();
   st.counters["dofs"] = dofs;
 }
 
@@ -98,7 +103,33 @@ BENCHMARK(BM_Dot)->Name("Dot")->Arg(1 << 20)->Arg(1 << 24)->UseRealTime();
 }  // namespace
 }  // namespace tresca
 
+static const char* kHelp =
+    "usage: bench_kernels [Google Benchmark options]\n"
+    "The kernels one by one on the fields of mesh levels 6-12 (Apply, ApplyFloat, ApplyRef: the\n"
+    "serial _ref twin, VCycle, RestrictProlong, Dot), each with the counters DoF/s, bytes/s and\n"
+    "FLOP/s from the kernels' cost models, omp_threads and dofs; the build (ISA, vector width,\n"
+    "compiler) is in the context header.\n"
+    "  --benchmark_filter=REGEX        which ones, e.g. 'Apply/10|VCycle/10'\n"
+    "  --benchmark_repetitions=N       repeat each; with --benchmark_report_aggregates_only=true\n"
+    "                                  only the mean, median, stddev and cv are printed\n"
+    "  --benchmark_format=json, --benchmark_out=FILE  machine-readable output\n"
+    "  --benchmark_list_tests          the names\n"
+    "  --help-benchmark                Google Benchmark's own list of options\n"
+    "  -h, --help                      this text;  --version  the version and the build\n"
+    "Threads: OMP_NUM_THREADS (default all cores).\n";
+
 int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "-h") || !std::strcmp(argv[i], "--help")) {
+      std::fputs(kHelp, stdout);
+      return 0;
+    }
+    if (!std::strcmp(argv[i], "--version")) {
+      std::fputs(tresca::version_text("bench_kernels").c_str(), stdout);
+      return 0;
+    }
+    if (!std::strcmp(argv[i], "--help-benchmark")) argv[i] = const_cast<char*>("--help");
+  }
   benchmark::AddCustomContext("tresca kernels", tresca::build_info());
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

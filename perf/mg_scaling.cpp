@@ -12,15 +12,23 @@
 
 using namespace tresca;
 
+static const char* kHelp =
+    "usage: mg_scaling [--levels A-B] [--rtol R] [--threads N] [--precision single|double] [--json FILE]\n"
+    "The inner solver alone: multigrid-preconditioned CG for K_ii u = l_i on each level A..B,\n"
+    "one row per level (dofs, V-cycle levels, iterations, setup and solve time, dof/s).\n"
+    "  --levels A-B       mesh levels (default 3-11)\n"
+    "  --rtol R           relative residual (default 1e-10, in (0,1))\n"
+    "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
+    "  --precision single|double  arithmetic of the V-cycles (default single)\n"
+    "  --json FILE        the rows as JSON\n"
+    "  -h, --help         this text;  --version  the version and the build (ISA, compiler)\n";
+
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
   require_one_rank("mg_scaling");
   try {
-    Args a(argc, argv, {"--levels", "--rtol", "--threads", "--json", "--precision"}, {"--help"});
-    if (a.has("--help")) {
-      std::puts("usage: mg_scaling [--levels 3-11] [--rtol 1e-10] [--threads N] [--precision single|double] [--json FILE]");
-      return 0;
-    }
+    Args a(argc, argv, {"--levels", "--rtol", "--threads", "--json", "--precision"}, {});
+    if (answered_help_or_version(a, "mg_scaling", kHelp)) return 0;
     MGOptions mo;
     const std::string prec = a.str("--precision", "single");
     if (prec != "single" && prec != "double")

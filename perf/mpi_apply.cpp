@@ -37,7 +37,16 @@ static const char* kHelp =
     "usage: mpi_apply [--level L | --dims EXxEYxEZ] [--reps N] [--rtol R] [--max-iterations N] [--threads N]\n"
     "                 [--project LEVEL,RANKS] [--latency S] [--bandwidth B/s] [--rate DOF/s] [--outer N] [--inner N]\n"
     "The distributed elasticity apply and a Jacobi-CG on y-slabs, one per MPI rank (default --level 8).\n"
-    "Run it with mpirun -np P; --project prints the communication model's projection instead.\n";
+    "Run it with mpirun -np P; --project prints the communication model's projection instead.\n"
+    "  --level L | --dims EXxEYxEZ  the mesh (default --level 8)\n"
+    "  --reps N           applies timed (default 20)\n"
+    "  --rtol R           relative residual of the Jacobi-CG (default 1e-6)\n"
+    "  --max-iterations N its iteration limit (default 20000)\n"
+    "  --threads N        OpenMP threads per rank (default: OMP_NUM_THREADS or all cores)\n"
+    "  --project L,P      the model's time per apply and per MG-CG iteration at level L on P ranks\n"
+    "  --latency S, --bandwidth B/s, --rate DOF/s  the network and node model of --project\n"
+    "  --outer N, --inner N   Newton's outer and inner iterations the projection multiplies\n"
+    "  -h, --help         this text;  --version  the version and the build (ISA, compiler)\n";
 
 namespace {
 
@@ -95,11 +104,8 @@ int main(int argc, char** argv) {
   try {
     Args a(argc, argv,
            {"--level", "--dims", "--reps", "--rtol", "--max-iterations", "--threads", "--project", "--latency", "--bandwidth", "--rate", "--outer", "--inner"},
-           {"--help"});
-    if (a.has("--help")) {
-      if (comm.rank() == 0) std::fputs(kHelp, stdout);
-      return 0;
-    }
+           {});
+    if (answered_help_or_version(a, "mpi_apply", kHelp)) return 0;
     const int threads = apply_threads(a);
     if (a.has("--project")) return comm.rank() == 0 ? project(a) : 0;
     const ProblemSpec spec = spec_from_args(a, 8);

@@ -10,6 +10,7 @@
 //   build/bin/scaling --levels 4-10 --threads 1,2 --json perf/scaling.json
 #include <omp.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <sstream>
@@ -25,15 +26,31 @@
 
 using namespace tresca;
 
+static const char* kHelp =
+    "usage: scaling [--levels A-B] [--threads 1,2,...] [--repeat N] [--phi F | --coulomb F [--coulomb-method M]]\n"
+    "               [--no-nested] [--json FILE]\n"
+    "Whole contact solves on each level A..B with each thread count, one row per (level, threads):\n"
+    "times per phase, Newton / outer / inner iterations, S applications, fine-grid matvec\n"
+    "equivalents (fmv) per Newton step and per solve, against one MG-CG solve of K_ii to 1e-10\n"
+    "on the same mesh, peak memory and the speed-up over the first thread count.\n"
+    "  --levels A-B       mesh levels (default 4-10)\n"
+    "  --threads T1,T2    thread counts (default 1,2)\n"
+    "  --repeat N         solve each (level, threads) N times (default 1); the row is the run of\n"
+    "                     median total time, with the range of the N totals beside it\n"
+    "  --phi F            Tresca friction bound (default 1)\n"
+    "  --coulomb F        Coulomb friction instead;  --coulomb-method newton|lagged|fixed-point\n"
+    "  --no-nested        start every Newton from x0 = 0 on its own mesh\n"
+    "  --json FILE        the rows as JSON (the run-summary schema plus speedup, repeats,\n"
+    "                     total_seconds_runs, fine_matvecs_linear_solve, contact_over_linear)\n"
+    "  -h, --help         this text;  --version  the version and the build (ISA, compiler)\n"
+    "Exit status: 0 all converged, 1 some did not, 2 bad input.\n";
+
 int main(int argc, char** argv) {
   default_runtime_environment(argv);
   require_one_rank("scaling");
   try {
-    Args a(argc, argv, {"--levels", "--threads", "--phi", "--coulomb", "--coulomb-method", "--json"}, {"--help", "--no-nested"});
-    if (a.has("--help")) {
-      std::puts("usage: scaling [--levels 4-10] [--threads 1,2] [--phi F | --coulomb F [--coulomb-method M]] [--no-nested] [--json FILE]");
-      return 0;
-    }
+    Args a(argc, argv, {"--levels", "--threads", "--repeat", "--phi", "--coulomb", "--coulomb-method", "--json"}, {"--no-nested"});
+    if (answered_help_or_version(a, "scaling", kHelp)) return 0;
     const auto levels = parse_level_range(a.str("--levels", "4-10"));
     std::vector<int> threads;
     {
@@ -46,6 +63,8 @@ int main(int argc, char** argv) {
         threads.push_back(int(v));
       }
     }
+    const long long repeat = a.int_value("--repeat", 1);
+    if (repeat < 1 || repeat > 1000) throw std::invalid_argument("--repeat " + a.str("--repeat") + " must be in 1..1000");
     const double phi = a.real_value("--phi", 1.0);
     const bool nested = !a.has("--no-nested");
     const FrictionLaw::CoulombMethod method =
@@ -64,6 +83,8 @@ int main(int argc, char** argv) {
     std::printf("%5s %3s %10s %8s %8s %8s %8s %8s %8s %4s %6s %6s %6s %6s %8s %8s %9s %8s %6s %8s %7s\n", "level", "thr",
                 "dofs", "nested", "setup", "condense", "solve", "recover", "total", "fp", "newton", "outer", "inner", "S-app",
                 "fmv/step", "fmv nest", "fmv/solve", "fmv K_ii", "ratio", "peak GB", "speedup");
+    if (repeat > 1)
+      std::printf("# each row: the median of %lld solves by total time; [min-max] of their totals after it\n", repeat);
     bool all_converged = true;
     Json rows = Json::array();
     for (int L : levels) {
@@ -87,23 +108,51 @@ int main(int argc, char** argv) {
         o.recover_interior = true;
         o.nested = nested;
         o.friction = friction;
-        const RunResult R = run_tresca(s, o);
-        if (T == threads.front()) t_first = R.times.total;
-        const double speedup = t_first / R.times.total;
-        std::printf("%5d %3d %10lld %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %4d %6d %6lld %6lld %6lld %8.1f %8.1f %9.1f %8.1f %6.1f %8.2f %7.2f %s\n",
-                    L, T, (long long)R.problem->free_dofs(), R.times.nested, R.times.setup, R.times.condense,
-                    R.times.solve, R.times.recover, R.times.total, R.coulomb() ? R.coulomb_loop.iterations : 0,
-                    int(R.newton_steps()), R.newton.outer_iterations,
-                    R.inner_iterations, R.newton.operator_applications, R.fine_matvecs_per_newton_step(),
-                    R.nested_fine_matvecs, R.fine_matvecs_total, fmv_linear,
-                    R.fine_matvecs_total / fmv_linear, R.peak_memory / 1e9, speedup,
-                    R.converged() ? "" : R.reason().c_str());
-        all_converged = all_converged && R.converged();
+        // every repetition's row and summary; the median's are kept
+        std::vector<double> totals;
+        std::vector<std::string> lines, reasons;
+        std::vector<Json> summaries;
+        for (long long rep = 0; rep < repeat; ++rep) {
+          profile_reset();  // each run's profile its own
+          const RunResult R = run_tresca(s, o);
+          char line[512];
+          std::snprintf(line, sizeof line,
+                        "%5d %3d %10lld %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %4d %6d %6lld %6lld %6lld %8.1f %8.1f %9.1f %8.1f %6.1f %8.2f",
+                        L, T, (long long)R.problem->free_dofs(), R.times.nested, R.times.setup, R.times.condense,
+                        R.times.solve, R.times.recover, R.times.total, R.coulomb() ? R.coulomb_loop.iterations : 0,
+                        int(R.newton_steps()), R.newton.outer_iterations, R.inner_iterations,
+                        R.newton.operator_applications, R.fine_matvecs_per_newton_step(), R.nested_fine_matvecs,
+                        R.fine_matvecs_total, fmv_linear, R.fine_matvecs_total / fmv_linear, R.peak_memory / 1e9);
+          lines.push_back(line);
+          reasons.push_back(R.converged() ? "" : " " + R.reason());
+          all_converged = all_converged && R.converged();
+          Json j = run_summary(s, R, T, o);
+          j["fine_matvecs_linear_solve"] = fmv_linear;
+          j["contact_over_linear"] = R.fine_matvecs_total / fmv_linear;
+          summaries.push_back(std::move(j));
+          totals.push_back(R.times.total);
+        }
+        std::vector<size_t> order(totals.size());
+        for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::sort(order.begin(), order.end(), [&](size_t x, size_t y) { return totals[x] < totals[y]; });
+        const size_t med = order[(order.size() - 1) / 2];
+        const double total = totals[med];
+        if (T == threads.front()) t_first = total;
+        const double speedup = t_first / total;
+        char tail[96];
+        std::snprintf(tail, sizeof tail, " %7.2f", speedup);
+        std::string range;
+        if (repeat > 1) {
+          char r[64];
+          std::snprintf(r, sizeof r, " [%.3f-%.3f]", totals[order.front()], totals[order.back()]);
+          range = r;
+        }
+        std::printf("%s%s%s%s\n", lines[med].c_str(), tail, range.c_str(), reasons[med].c_str());
         std::fflush(stdout);
-        Json j = run_summary(s, R, T, o);
+        Json j = summaries[med];
         j["speedup"] = speedup;
-        j["fine_matvecs_linear_solve"] = fmv_linear;
-        j["contact_over_linear"] = R.fine_matvecs_total / fmv_linear;
+        j["repeats"] = repeat;
+        j["total_seconds_runs"] = totals;
         rows.push_back(std::move(j));
       }
     }

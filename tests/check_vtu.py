@@ -6,10 +6,18 @@ Debian python3-vtk9) and checks them against the run's contact CSV and JSON:
   check_vtu.py --pvd P.pvd --steps N
   check_vtu.py --pvd P.pvd --json J.json      (a --vtk-every-iteration run)
   check_vtu.py --pvtu P.pvtu --vtu B.vtu --rtol R   (several ranks against one)
+  check_vtu.py --vtu U.vtu --json J.json --patch P --beyond X --rtol R   (patch test)
 
 - the body: (ex+1)(ey+1)(ez+1) points, ex*ey*ez hexahedra of positive volume
   (every cell is checked in vectorised form), its bottom plane's displacement
   equal to the contact file's;
+- the fields: cell stress and von Mises equal to those recomputed here from
+  the points and the displacement alone (isoparametric gradient at each
+  hexahedron's centre, Hooke's law with the run's E, nu), contact_pressure
+  times each node's share of the face equal to the normal contact force;
+- --patch P: the uniform-pressure patch test (tests/cases/uniform_pressure.json):
+  beyond x = X the contact pressure is P, the stress (0, 0, -P, 0, 0, 0) and
+  von Mises P, to R relative;
 - the contact file: displacement and lambda of every contact node equal to
   the CSV's (printed with 17 digits, so equal to the last bit up to one
   rounding), contact_status equal to the CSV's contact/stick columns;
@@ -54,10 +62,92 @@ def arrays(g):
     out = {"points": vtk_to_numpy(g.GetPoints().GetData()),
            "connectivity": vtk_to_numpy(g.GetCells().GetConnectivityArray()),
            "types": vtk_to_numpy(g.GetCellTypesArray())}
-    pd = g.GetPointData()
-    for i in range(pd.GetNumberOfArrays()):
-        out[pd.GetArrayName(i)] = vtk_to_numpy(pd.GetArray(i))
+    for data in (g.GetPointData(), g.GetCellData()):
+        for i in range(data.GetNumberOfArrays()):
+            out[data.GetArrayName(i)] = vtk_to_numpy(data.GetArray(i))
     return out
+
+
+def centre_stress(body, E, nu):
+    """Cauchy stress at every hexahedron's centre from its corners' points and
+    displacements alone (VTK node order, the isoparametric map: grad u =
+    du/dxi J^-1 at xi = 0), in VTK's order xx yy zz xy yz xz."""
+    conn = body["connectivity"].reshape(-1, 8)
+    q, u = body["points"][conn], body["displacement"][conn]  # cells x 8 x 3
+
+    def d_dxi(f):  # derivatives along the three reference axes at the centre
+        return np.stack([(f[:, 1] - f[:, 0] + f[:, 2] - f[:, 3] + f[:, 5] - f[:, 4] + f[:, 6] - f[:, 7]) / 4,
+                         (f[:, 3] - f[:, 0] + f[:, 2] - f[:, 1] + f[:, 7] - f[:, 4] + f[:, 6] - f[:, 5]) / 4,
+                         (f[:, 4] - f[:, 0] + f[:, 5] - f[:, 1] + f[:, 6] - f[:, 2] + f[:, 7] - f[:, 3]) / 4], axis=1)
+
+    J, G = d_dxi(q), d_dxi(u)  # J[c, i, :] = dx/dxi_i, G[c, i, :] = du/dxi_i
+    grad = np.linalg.solve(J, G).transpose(0, 2, 1)  # grad[c, a, d] = du_a/dx_d
+    eps = 0.5 * (grad + grad.transpose(0, 2, 1))
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    s = 2 * mu * eps + lam * np.trace(eps, axis1=1, axis2=2)[:, None, None] * np.eye(3)
+    return np.stack([s[:, 0, 0], s[:, 1, 1], s[:, 2, 2], s[:, 0, 1], s[:, 1, 2], s[:, 0, 2]], axis=1)
+
+
+def von_mises(s):
+    return np.sqrt(0.5 * ((s[:, 0] - s[:, 1]) ** 2 + (s[:, 1] - s[:, 2]) ** 2 + (s[:, 2] - s[:, 0]) ** 2)
+                   + 3 * (s[:, 3] ** 2 + s[:, 4] ** 2 + s[:, 5] ** 2))
+
+
+def nodal_area(points, ex, ey):
+    """each face node's share of the face: a quarter of every quad it is a corner of"""
+    x, y = points[:, 0], points[:, 1]
+    hx, hy = (x.max() - x.min()) / ex, (y.max() - y.min()) / ey
+    wx = np.where(np.isclose(x, x.min()) | np.isclose(x, x.max()), 0.5, 1.0)
+    wy = np.where(np.isclose(y, y.min()) | np.isclose(y, y.max()), 0.5, 1.0)
+    return wx * wy * hx * hy
+
+
+def check_fields(run, body, face):
+    """stress, von Mises and contact pressure against their definitions,
+    recomputed here from the points, the displacement and the contact force"""
+    E, nu = run["problem"]["material"]["E"], run["problem"]["material"]["nu"]
+    s = centre_stress(body, E, nu)
+    scale = max(np.abs(s).max(), 1e-300)
+    if body["stress"].shape != s.shape or np.abs(body["stress"] - s).max() > 1e-9 * scale:
+        fail("cell stress differs from the recomputed one by %.3e of its largest" %
+             (np.abs(body["stress"] - s).max() / scale))
+    if np.abs(body["von_mises"] - von_mises(s)).max() > 1e-9 * scale:
+        fail("von_mises differs from the recomputed one")
+    ex, ey, _ = run["dims"]
+    area = nodal_area(face["points"], ex, ey)
+    lam = face["contact_force"][:, 2]
+    fscale = max(np.abs(lam).max(), 1e-300)
+    if np.abs(face["contact_pressure"] * area - lam).max() > 1e-12 * fscale:
+        fail("contact_pressure x nodal area differs from the normal contact force")
+    m = len(face["points"])
+    if not np.array_equal(body["contact_pressure"][:m], face["contact_pressure"]):
+        fail("the body's contact_pressure differs from the contact file's")
+    return "stress, von Mises and contact pressure agree with their recomputation"
+
+
+def check_patch(args):
+    """the uniform-pressure patch test (tests/cases/uniform_pressure.json): beyond
+    x = --beyond, contact pressure = p, stress zz = -p, the rest 0, von Mises = p"""
+    with open(args.json) as f:
+        run = json.load(f)
+    body, face = arrays(read(args.vtu)), arrays(read(companion(args.vtu)))
+    p = args.patch
+    far = face["points"][:, 0] > args.beyond
+    dp = np.abs(face["contact_pressure"][far] - p).max() / p
+    conn = body["connectivity"].reshape(-1, 8)
+    centre = body["points"][conn].mean(axis=1)
+    cells = centre[:, 0] > args.beyond
+    uniform = np.array([0, 0, -p, 0, 0, 0])
+    ds = np.abs(body["stress"][cells] - uniform).max() / p
+    dv = np.abs(body["von_mises"][cells] - p).max() / p
+    if not (far.sum() > 0 and cells.sum() > 0):
+        fail("no face node or cell beyond x = %g" % args.beyond)
+    if dp > args.rtol or ds > args.rtol or dv > args.rtol:
+        fail("beyond x = %g: pressure off by %.2e, stress by %.2e, von Mises by %.2e of p (tolerance %g)" %
+             (args.beyond, dp, ds, dv, args.rtol))
+    print("%s: beyond x = %g (%d nodes, %d cells) pressure = p to %.1e, stress = (0,0,-p,0,0,0) to %.1e, "
+          "von Mises = p to %.1e; %s" % (args.vtu, args.beyond, far.sum(), cells.sum(), dp, ds, dv,
+                                         check_fields(run, body, face)))
 
 
 def companion(path):
@@ -100,14 +190,14 @@ def check_run(args):
     scale = np.abs(u).max()
     if np.abs(face["displacement"][n] - u).max() > 1e-15 * scale:
         fail("contact displacement differs from the CSV by %g" % np.abs(face["displacement"][n] - u).max())
-    if np.abs(face["lambda"][n] - lam).max() > 1e-15 * max(np.abs(lam).max(), 1):
+    if np.abs(face["contact_force"][n][:, 2] - lam).max() > 1e-15 * max(np.abs(lam).max(), 1):
         fail("lambda differs from the CSV")
     if not np.array_equal(face["contact_status"][n], code) or not np.array_equal(body["contact_status"][n], code):
         fail("contact_status differs from the CSV")
-    if not np.array_equal(body["contact_force"][n][:, 2], face["lambda"][n]):
-        fail("the body's contact_force z differs from lambda")
-    summary = "%s: %d points, %d cells, %d contact nodes agree with the CSV" % (
-        args.vtu, len(body["points"]), len(body["types"]), len(rows))
+    if not np.array_equal(body["contact_force"][:m], face["contact_force"]):
+        fail("the body's contact_force differs from the contact file's")
+    summary = "%s: %d points, %d cells, %d contact nodes agree with the CSV; %s" % (
+        args.vtu, len(body["points"]), len(body["types"]), len(rows), check_fields(run, body, face))
     if args.ascii:
         for b, a in ((body, arrays(read(args.ascii))), (face, arrays(read(companion(args.ascii))))):
             for k in b:
@@ -188,8 +278,12 @@ p.add_argument("--pvd")
 p.add_argument("--steps", type=int)
 p.add_argument("--pvtu")
 p.add_argument("--rtol", type=float, default=1e-10)
+p.add_argument("--patch", type=float, help="the applied pressure p of the patch test [Pa]")
+p.add_argument("--beyond", type=float, default=2.5, help="the patch test's uniform region: x > BEYOND")
 a = p.parse_args()
-if a.pvtu:
+if a.patch:
+    check_patch(a)
+elif a.pvtu:
     check_pvtu(a)
 elif a.pvd:
     check_pvd(a)

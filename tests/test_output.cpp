@@ -195,15 +195,27 @@ TEST_F(OutputFiles, VtuHoldsTheSolversFieldsOnPositiveVolumeHexahedra) {
   // the contact face: quads over the bottom plane with the same values
   const std::string vc = slurp(cpath);
   const auto cd = data_array(vc, "displacement");
-  const auto cl = data_array(vc, "lambda");
+  const auto cf = data_array(vc, "contact_force");
+  const auto cp = data_array(vc, "contact_pressure");
   const auto cc = data_array(vc, "contact_status");
   const index M = g.nx() * g.ny();
   ASSERT_EQ(index(cd.size()), 3 * M);
+  ASSERT_EQ(index(cf.size()), 3 * M);
+  ASSERT_EQ(index(cp.size()), M);
+  double pressure_times_area = 0;
   for (index n = 0; n < M; ++n) {
     for (int a = 0; a < 3; ++a) ASSERT_NEAR(cd[3 * n + a], R_->u_full[a * N + n], us);
-    EXPECT_NEAR(cl[n], cid[n] < 0 ? 0.0 : R_->newton.lambda[cid[n]], 1e-11 * std::abs(R_->report.lambda_sum));
+    const double lambda = cid[n] < 0 ? 0.0 : R_->newton.lambda[cid[n]];
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(cf[3 * n + a], force[3 * n + a], 1e-11 * std::abs(R_->report.lambda_sum));
+    EXPECT_NEAR(cf[3 * n + 2], lambda, 1e-11 * std::abs(R_->report.lambda_sum));
     EXPECT_EQ(cc[n], cid[n] < 0 ? 0 : status_code(R_->report.status[cid[n]]));
+    // the node's share of the face: a quarter of each quad it is a corner of
+    const index ix = n % g.nx(), iy = n / g.nx();
+    const double share = (ix == 0 || ix == g.ex ? 0.5 : 1) * (iy == 0 || iy == g.ey ? 0.5 : 1) * g.hx() * g.hy();
+    EXPECT_NEAR(cp[n] * share, lambda, 1e-11 * std::abs(R_->report.lambda_sum)) << "node " << n;
+    pressure_times_area += cp[n] * share;
   }
+  EXPECT_NEAR(pressure_times_area, R_->report.lambda_sum, 1e-10 * std::abs(R_->report.lambda_sum));
   // its quads: each the face's element, its corners in order around it
   // (a bow-tie has signed area 0), all facing the same way, tiling the face
   const auto fp = data_array(vc, "", "<Points>");

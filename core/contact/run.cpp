@@ -26,173 +26,178 @@ ContactConditions contact_conditions(const ProblemSpec& spec) {
   return c;
 }
 
-RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
-  RunResult R;
-  R.friction = opt.friction;
-  const double t0 = wall_time();
-  R.problem = std::make_unique<Problem>(make_problem(spec));
-  R.contact = opt.contact.phi.empty() ? contact_conditions(spec) : opt.contact;
-  // nested iteration: the coarser mesh first (before this mesh's operators
-  // exist, so the peak memory stays this mesh's). It hands up (u, lambda)
-  // as the Newton initial iterate and, trilinearly interpolated, its body
-  // and K_ii^{-1} l_i as initial guesses of this mesh's first residual and |b̃|.
-  // A given initial iterate (a restart, a continuation) competes with the
-  // coarser mesh's solution: Newton starts from the one of smaller merit
-  // |w| (a continuation step in phi or load can leave the old solution
-  // further from the new one than the cheap coarse solve is).
-  NewtonOptions newton = opt.newton;
-  const std::vector<real>* given_u0 = newton.u0;
-  const std::vector<real>* given_lambda0 = newton.lambda0;
-  newton.u0 = newton.lambda0 = nullptr;
-  std::vector<real> u0, lambda0, load_guess, body;  // body: the guess at u0, then U = E u + K_ii^{-1} l_i
-  if (opt.nested && has_coarser(spec, opt.nested_min_contact_nodes)) {
-    const ProblemSpec cs = coarser_spec(spec);
-    RunOptions co = opt;
-    co.newton.u0 = co.newton.lambda0 = nullptr;  // (a given iterate is this mesh's)
-    co.recover_interior = true;
-    co.keep_interior_load = true;
-    co.newton.progress = nullptr;
-    co.iterate_done = nullptr;
-    co.phase_done = nullptr;  // one line per coarse mesh: nested_done
-    co.newton.rtol = opt.nested_rtol;
-    co.coulomb_tol = std::max(opt.coulomb_tol, opt.nested_rtol);
-    // and need their forces only to a fraction of that accuracy
-    co.tight_rtol = std::max(opt.tight_rtol, 1e-3 * opt.nested_rtol);
-    co.newton.residual_accuracy = std::max(opt.newton.residual_accuracy, 1e-3 * opt.nested_rtol);
-    co.contact = coarse_conditions(R.problem->grid, R.contact, grid_of(cs));
-    const RunResult C = run_tresca(cs, co);
-    R.nested = C.nested;
-    R.nested.push_back({cs, int(C.newton_steps()), C.converged(), C.fine_matvecs_total - C.nested_fine_matvecs,
-                        C.times.total - C.times.nested});
-    R.nested_fine_matvecs = C.fine_matvecs_total * double(cs.free_dofs()) / double(spec.free_dofs());
-    if (opt.nested_done) opt.nested_done(R.nested.back());
-    if (C.converged()) {
-      prolongate_contact(C.problem->grid, C.newton.u, C.newton.lambda, R.problem->grid, u0, lambda0);
-      newton.u0 = &u0;
-      newton.lambda0 = &lambda0;
-      // on the slab this mesh's operators will use (the whole grid on one rank)
-      const Comm& comm = Comm::world();
-      const Comm& split = split_over(R.problem->grid, comm);  // as SteklovPoincare's
-      const Slab fine = make_slab(R.problem->grid, split.rank(), split.size());
-      const index n = 3 * fine.local.nodes();
-      load_guess.resize(n);
-      body.resize(n);
-      prolongate_slabs(C.slab, C.interior_load.data(), fine, load_guess.data(), comm);
-      prolongate_slabs(C.slab, C.u_full.data(), fine, body.data(), comm);
-      newton.body0 = &body;
-    }
+namespace {
+
+// What this mesh's Newton starts from: the coarser mesh's solution
+// (interpolated), a given initial iterate, and the guesses of the body and
+// of K_ii^{-1} l_i; NewtonOptions points into it
+struct Start {
+  std::vector<real> u0, lambda0;  // the coarser mesh's (empty: none)
+  std::vector<real> load_guess;   // K_ii^{-1} l_i, interpolated
+  std::vector<real> body;         // the guess at u0, then U = E u + K_ii^{-1} l_i
+  const std::vector<real>* given_u0 = nullptr;  // a restart's or continuation's
+  const std::vector<real>* given_lambda0 = nullptr;
+  std::vector<real> local[4];  // this rank's part of u0, lambda0, given u0, given lambda0
+  std::vector<real> given_body, r0, r_given;
+};
+
+// Nested iteration: the coarser mesh first (before this mesh's operators
+// exist, so the peak memory stays this mesh's). It hands up (u, lambda) as
+// the Newton initial iterate and, trilinearly interpolated, its body and
+// K_ii^{-1} l_i as initial guesses of this mesh's first residual and |b̃|.
+void solve_coarser_mesh(const ProblemSpec& spec, const RunOptions& opt, RunResult& R, Start& start,
+                        NewtonOptions& newton) {
+  const ProblemSpec cs = coarser_spec(spec);
+  RunOptions co = opt;
+  co.newton.u0 = co.newton.lambda0 = nullptr;  // (a given iterate is this mesh's)
+  co.recover_interior = true;
+  co.keep_interior_load = true;
+  co.newton.progress = nullptr;
+  co.iterate_done = nullptr;
+  co.phase_done = nullptr;  // one line per coarse mesh: nested_done
+  co.newton.rtol = opt.nested_rtol;
+  co.coulomb_tol = std::max(opt.coulomb_tol, opt.nested_rtol);
+  // and need their forces only to a fraction of that accuracy
+  co.tight_rtol = std::max(opt.tight_rtol, 1e-3 * opt.nested_rtol);
+  co.newton.residual_accuracy = std::max(opt.newton.residual_accuracy, 1e-3 * opt.nested_rtol);
+  co.contact = coarse_conditions(R.problem->grid, R.contact, grid_of(cs));
+  const RunResult C = run_tresca(cs, co);
+  R.nested = C.nested;
+  R.nested.push_back({cs, int(C.newton_steps()), C.converged(), C.fine_matvecs_total - C.nested_fine_matvecs,
+                      C.times.total - C.times.nested});
+  R.nested_fine_matvecs = C.fine_matvecs_total * double(cs.free_dofs()) / double(spec.free_dofs());
+  if (opt.nested_done) opt.nested_done(R.nested.back());
+  if (!C.converged()) return;
+  prolongate_contact(C.problem->grid, C.newton.u, C.newton.lambda, R.problem->grid, start.u0, start.lambda0);
+  newton.u0 = &start.u0;
+  newton.lambda0 = &start.lambda0;
+  // on the slab this mesh's operators will use (the whole grid on one rank)
+  const Comm& comm = Comm::world();
+  const Comm& split = split_over(R.problem->grid, comm);  // as SteklovPoincare's
+  const Slab fine = make_slab(R.problem->grid, split.rank(), split.size());
+  const index n = 3 * fine.local.nodes();
+  start.load_guess.resize(n);
+  start.body.resize(n);
+  prolongate_slabs(C.slab, C.interior_load.data(), fine, start.load_guess.data(), comm);
+  prolongate_slabs(C.slab, C.u_full.data(), fine, start.body.data(), comm);
+  newton.body0 = &start.body;
+}
+
+// RunOptions::iterate_done: each iterate's body (E u from one S apply, plus
+// K_ii^{-1} l_i) and every contact node's values (several ranks: gathered)
+void show_iterates(const SteklovPoincare& S, const RunOptions& opt, RunResult& R, NewtonOptions& newton) {
+  const Slab rows = S.slab();
+  newton.progress = [S = &S, R = &R, done = opt.iterate_done, rows, shown = newton.progress,
+                     step = 0](const NewtonProgress& pr) mutable {
+    if (shown) shown(pr);
+    std::vector<real> r(pr.u->size()), u_full(S->full_size());
+    S->residual(pr.u->data(), r.data(), 1e-8, u_full.data());
+    S->exchange_ghosts(u_full.data());
+    const std::vector<real> u = S->whole(*pr.u, 3), lambda = S->whole(*pr.lambda, 1), rw = S->whole(*pr.r, 3),
+                            phi = S->whole(*pr.phi, 1);
+    const std::vector<std::uint8_t> status = S->whole(*pr.status);
+    NewtonProgress whole = pr;
+    whole.u = &u;
+    whole.lambda = &lambda;
+    whole.r = &rw;
+    whole.phi = &phi;
+    whole.status = &status;
+    done(Iterate{R->problem.get(), step++, &whole, &u_full, &R->contact.gap, &rows});
+  };
+}
+
+// this rank's contact nodes (all of them on one rank): the law and the initial iterates
+ContactConditions this_ranks_part(const SteklovPoincare& S, const ContactConditions& all, NewtonOptions& newton,
+                                  Start& start) {
+  ContactConditions law = all;
+  if (!S.distributed()) return law;
+  law.phi = S.local_part(all.phi, 1);
+  law.gap = S.local_part(all.gap, 1);
+  auto localise = [&](const std::vector<real>*& u, const std::vector<real>*& lambda, std::vector<real>* part) {
+    if (!u || !lambda) return;
+    part[0] = S.local_part(*u, 3);
+    part[1] = S.local_part(*lambda, 1);
+    u = &part[0];
+    lambda = &part[1];
+  };
+  localise(newton.u0, newton.lambda0, start.local);
+  localise(start.given_u0, start.given_lambda0, start.local + 2);
+  return law;
+}
+
+// A given initial iterate (a restart, a continuation) competes with the
+// coarser mesh's solution: Newton starts from the one of smaller merit |w|
+// (a continuation step in phi or load can leave the old solution further
+// from the new one than the cheap coarse solve is). Both are measured at the
+// first residual's accuracy, each body warm for Newton.
+void choose_initial_iterate(const SteklovPoincare& S, const RunOptions& opt, const ContactConditions& law,
+                            NewtonOptions& newton, Start& start, RunResult& R) {
+  if (!start.given_u0) return;
+  if (!newton.u0) {
+    newton.u0 = start.given_u0;
+    newton.lambda0 = start.given_lambda0;
+    return;
   }
-  const double t0s = wall_time();
-  SteklovPoincare S(*R.problem, opt.mg);
-  const double t1 = wall_time();
-  if (opt.phase_done) opt.phase_done("setup (mesh, operators, multigrid)", t1 - t0s);
-  if (opt.iterate_done) {
-    // each iterate's body: E u from one S apply, plus K_ii^{-1} l_i
-    const Slab rows = S.slab();
-    newton.progress = [&, rows, shown = newton.progress, step = 0](const NewtonProgress& pr) mutable {
-      if (shown) shown(pr);
-      std::vector<real> r(pr.u->size()), u_full(S.full_size());
-      S.residual(pr.u->data(), r.data(), 1e-8, u_full.data());
-      S.exchange_ghosts(u_full.data());
-      // every contact node's values (several ranks: gathered)
-      const std::vector<real> u = S.whole(*pr.u, 3), lambda = S.whole(*pr.lambda, 1), rw = S.whole(*pr.r, 3),
-                              phi = S.whole(*pr.phi, 1);
-      const std::vector<std::uint8_t> status = S.whole(*pr.status);
-      NewtonProgress whole = pr;
-      whole.u = &u;
-      whole.lambda = &lambda;
-      whole.r = &rw;
-      whole.phi = &phi;
-      whole.status = &status;
-      opt.iterate_done(Iterate{R.problem.get(), step++, &whole, &u_full, &R.contact.gap, &rows});
-    };
+  const std::vector<real> units = step_scale(S);
+  // (to 1e-2: the merits differ by factors; the winner's r, body and that
+  // accuracy go to Newton, which refines r where it needs to)
+  const real choice_rtol = 1e-2;
+  auto merit = [&](const std::vector<real>& u, const std::vector<real>& lambda, std::vector<real>& b,
+                   std::vector<real>& r, bool warm) {
+    const index p = S.contact_nodes();
+    std::vector<real> v(4 * p), w(4 * p), d(3 * p);
+    std::vector<std::uint8_t> st(p);
+    r.resize(3 * p);
+    b.resize(S.full_size());
+    const SolveStats st_r = S.residual(u.data(), r.data(), choice_rtol, b.data(), warm ? b.data() : nullptr);
+    R.choice_fine_matvecs += S.apply_work(st_r.iterations);
+    ContactConditions l = law;
+    if (opt.friction.is_coulomb()) l.set_coulomb_bound(opt.friction.F, lambda);
+    const ResidualNorms n = approximation_step(p, l.law(newton.kink_contact), nullptr, units.data(), u.data(),
+                                               lambda.data(), r.data(), v.data(), w.data(), d.data(), st.data());
+    return std::sqrt(S.sum(n.consistent));
+  };
+  const real coarse = merit(*newton.u0, *newton.lambda0, start.body, start.r0, true);
+  const real given = merit(*start.given_u0, *start.given_lambda0, start.given_body, start.r_given, false);
+  R.initial_iterate = given <= coarse ? "given" : "coarser mesh";
+  if (opt.phase_done) {
+    const std::string what = "initial iterate: the " + R.initial_iterate + "'s (|w| given " + std::to_string(given) +
+                             " N, coarser mesh " + std::to_string(coarse) + " N)";
+    opt.phase_done(what.c_str(), 0);
   }
-  // this rank's contact nodes (all of them on one rank): the law and the initial iterates
-  ContactConditions law = R.contact;
-  std::vector<real> u0_local, lambda0_local, given_u0_local, given_lambda0_local;
-  if (S.distributed()) {
-    law.phi = S.local_part(R.contact.phi, 1);
-    law.gap = S.local_part(R.contact.gap, 1);
-    if (newton.u0 && newton.lambda0) {
-      u0_local = S.local_part(*newton.u0, 3);
-      lambda0_local = S.local_part(*newton.lambda0, 1);
-      newton.u0 = &u0_local;
-      newton.lambda0 = &lambda0_local;
-    }
-    if (given_u0 && given_lambda0) {
-      given_u0_local = S.local_part(*given_u0, 3);
-      given_lambda0_local = S.local_part(*given_lambda0, 1);
-      given_u0 = &given_u0_local;
-      given_lambda0 = &given_lambda0_local;
-    }
+  if (given <= coarse) {
+    newton.u0 = start.given_u0;
+    newton.lambda0 = start.given_lambda0;
+    start.body = std::move(start.given_body);
+    start.r0 = std::move(start.r_given);
   }
-  std::vector<real> given_body, r_coarse, r_given;
-  if (given_u0) {
-    if (!newton.u0) {
-      newton.u0 = given_u0;
-      newton.lambda0 = given_lambda0;
-    } else {
-      // both at the first residual's accuracy, each body warm for Newton
-      const std::vector<real> units = step_scale(S);
-      // (to 1e-2: the merits differ by factors; the winner's r, body and
-      // that accuracy go to Newton, which refines r where it needs to)
-      const real choice_rtol = 1e-2;
-      auto merit = [&](const std::vector<real>& u, const std::vector<real>& lambda, std::vector<real>& b,
-                       std::vector<real>& r, bool warm) {
-        const index p = S.contact_nodes();
-        std::vector<real> v(4 * p), w(4 * p), d(3 * p);
-        std::vector<std::uint8_t> st(p);
-        r.resize(3 * p);
-        b.resize(S.full_size());
-        const SolveStats st_r = S.residual(u.data(), r.data(), choice_rtol, b.data(), warm ? b.data() : nullptr);
-        R.choice_fine_matvecs += S.apply_work(st_r.iterations);
-        ContactConditions l = law;
-        if (opt.friction.is_coulomb()) l.set_coulomb_bound(opt.friction.F, lambda);
-        const ResidualNorms n = approximation_step(p, l.law(newton.kink_contact), nullptr, units.data(), u.data(),
-                                                   lambda.data(), r.data(), v.data(), w.data(), d.data(), st.data());
-        return std::sqrt(S.sum(n.consistent));
-      };
-      const real coarse = merit(*newton.u0, *newton.lambda0, body, r_coarse, true);
-      const real given = merit(*given_u0, *given_lambda0, given_body, r_given, false);
-      R.initial_iterate = given <= coarse ? "given" : "coarser mesh";
-      if (opt.phase_done) {
-        const std::string what = "initial iterate: the " + R.initial_iterate + "'s (|w| given " +
-                                 std::to_string(given) + " N, coarser mesh " + std::to_string(coarse) + " N)";
-        opt.phase_done(what.c_str(), 0);
-      }
-      if (given <= coarse) {
-        newton.u0 = given_u0;
-        newton.lambda0 = given_lambda0;
-        body = std::move(given_body);
-        r_coarse = std::move(r_given);
-      }
-      newton.r0 = &r_coarse;
-      newton.r0_accuracy = choice_rtol;
-    }
-  }
-  // |b̃|, the scale of Newton's absolute accuracies and of the report: from
-  // x0 = 0 Newton's first residual is -b̃; an initial iterate takes a loose
-  // solve of its own (a coarser mesh of nested iteration always, to hand up
-  // its K_ii^{-1} l_i)
+  newton.r0 = &start.r0;
+  newton.r0_accuracy = choice_rtol;
+}
+
+// |b̃|, the scale of Newton's absolute accuracies and of the report: from
+// x0 = 0 Newton's first residual is -b̃ (nothing to do here); an initial
+// iterate takes a loose solve of its own (a coarser mesh of nested
+// iteration always, to hand up its K_ii^{-1} l_i)
+SolveStats scale_of_load(const SteklovPoincare& S, const RunOptions& opt, NewtonOptions& newton, Start& start,
+                         RunResult& R) {
   SolveStats cond;
-  const bool loose_load = newton.u0 || opt.keep_interior_load;
-  if (loose_load) {
+  if (newton.u0 || opt.keep_interior_load) {
     std::vector<real> btilde;
     cond = S.condensed_load(opt.scale_rtol, btilde, opt.keep_interior_load ? &R.interior_load : nullptr,
-                            load_guess.empty() ? nullptr : load_guess.data());
+                            start.load_guess.empty() ? nullptr : start.load_guess.data());
     newton.force_scale = std::sqrt(S.sum(dot(index(btilde.size()), btilde.data(), btilde.data())));
   }
-  load_guess = {};
-  const double t2 = wall_time();
-  if (opt.phase_done && loose_load) opt.phase_done("|b~| (loose condensed load)", t2 - t1);
-  if (!cond.ok()) {
-    // b̃ is untrustworthy: report instead of iterating on a wrong problem
-    const index p = S.contact_nodes();
-    R.newton.reason = NewtonReason::inner_failure;
-    R.newton.u.assign(3 * p, 0);
-    R.newton.lambda.assign(p, 0);
-    R.newton.status.assign(p, 0);
-  } else if (opt.friction.bound_follows_lambda()) {
+  start.load_guess = {};
+  return cond;
+}
+
+// The contact problem by the friction law's method: one semismooth* Newton
+// solve (Tresca; Coulomb by Newton with the bound following lambda), or
+// Coulomb's fixed point of Tresca solves. `law` ends with the bound used.
+void solve_contact(const SteklovPoincare& S, const RunOptions& opt, ContactConditions& law, NewtonOptions& newton,
+                   RunResult& R) {
+  if (opt.friction.bound_follows_lambda()) {
     newton.friction = opt.friction;
     R.newton = semismooth_newton(S, law, newton);
     law.phi = R.newton.phi;
@@ -214,33 +219,77 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   }
   if (R.coulomb()) {
     for (index i = 0; i < S.contact_nodes(); ++i)
-      R.coulomb_consistency =
-          std::max(R.coulomb_consistency, std::abs(law.phi[i] - opt.friction.F * std::max(real(0), R.newton.lambda[i])));
+      R.coulomb_consistency = std::max(R.coulomb_consistency,
+                                       std::abs(law.phi[i] - opt.friction.F * std::max(real(0), R.newton.lambda[i])));
     R.coulomb_consistency = S.max(R.coulomb_consistency);
+  }
+}
+
+// the run's results for every contact node on every rank (outputs, the next
+// finer mesh of nested iteration)
+void gather_contact_values(const SteklovPoincare& S, ContactConditions& law, RunResult& R) {
+  if (!S.distributed()) return;
+  NewtonResult& N = R.newton;
+  N.u = S.whole(N.u, 3);
+  N.lambda = S.whole(N.lambda, 1);
+  N.r = S.whole(N.r, 3);
+  N.status = S.whole(N.status);
+  N.phi = S.whole(N.phi, 1);
+  if (!N.scale.empty()) N.scale = S.whole(N.scale, 1);
+  law.phi = S.whole(law.phi, 1);
+  law.gap = S.whole(law.gap, 1);
+  R.report.r = S.whole(R.report.r, 3);
+  R.report.status = S.whole(R.report.status);
+}
+
+}  // namespace
+
+RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
+  RunResult R;
+  R.friction = opt.friction;
+  const double t0 = wall_time();
+  R.problem = std::make_unique<Problem>(make_problem(spec));
+  R.contact = opt.contact.phi.empty() ? contact_conditions(spec) : opt.contact;
+  NewtonOptions newton = opt.newton;
+  Start start;
+  start.given_u0 = newton.u0;
+  start.given_lambda0 = newton.lambda0;
+  newton.u0 = newton.lambda0 = nullptr;
+  if (opt.nested && has_coarser(spec, opt.nested_min_contact_nodes)) solve_coarser_mesh(spec, opt, R, start, newton);
+
+  const double t0s = wall_time();
+  SteklovPoincare S(*R.problem, opt.mg);
+  const double t1 = wall_time();
+  if (opt.phase_done) opt.phase_done("setup (mesh, operators, multigrid)", t1 - t0s);
+  if (opt.iterate_done) show_iterates(S, opt, R, newton);
+  ContactConditions law = this_ranks_part(S, R.contact, newton, start);
+  choose_initial_iterate(S, opt, law, newton, start, R);
+  const bool loose_load = newton.u0 || opt.keep_interior_load;
+  const SolveStats cond = scale_of_load(S, opt, newton, start, R);
+  const double t2 = wall_time();
+  if (opt.phase_done && loose_load) opt.phase_done("|b~| (loose condensed load)", t2 - t1);
+
+  if (cond.ok()) {
+    solve_contact(S, opt, law, newton, R);
+  } else {
+    // b̃ is untrustworthy: report instead of iterating on a wrong problem
+    const index p = S.contact_nodes();
+    R.newton.reason = NewtonReason::inner_failure;
+    R.newton.u.assign(3 * p, 0);
+    R.newton.lambda.assign(p, 0);
+    R.newton.status.assign(p, 0);
   }
   const double t3 = wall_time();
   if (opt.phase_done) opt.phase_done("semismooth* Newton", t3 - t2);
+
   // the final check's tight residual, warm from Newton's body (or, if
   // Newton did not run, the guess at u0), also recovers the body
+  std::vector<real> body = std::move(start.body);
   if (!R.newton.body.empty()) body = std::move(R.newton.body);
   R.newton.body = {};
   R.report = final_report(S, law, R.newton, opt.tight_rtol, &body,
                           std::max(R.newton.tolerance, opt.kkt_rtol * R.newton.force_scale));
-  if (S.distributed()) {
-    // the run's results for every contact node on every rank (outputs, the
-    // next finer mesh of nested iteration)
-    NewtonResult& N = R.newton;
-    N.u = S.whole(N.u, 3);
-    N.lambda = S.whole(N.lambda, 1);
-    N.r = S.whole(N.r, 3);
-    N.status = S.whole(N.status);
-    N.phi = S.whole(N.phi, 1);
-    if (!N.scale.empty()) N.scale = S.whole(N.scale, 1);
-    law.phi = S.whole(law.phi, 1);
-    law.gap = S.whole(law.gap, 1);
-    R.report.r = S.whole(R.report.r, 3);
-    R.report.status = S.whole(R.report.status);
-  }
+  gather_contact_values(S, law, R);
   R.contact = std::move(law);
   R.slab = S.slab();
   if (opt.recover_interior) {
@@ -260,23 +309,21 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.fine_matvecs_total = R.nested_fine_matvecs + R.newton_fine_matvecs() + S.apply_work(cond.iterations) +
                          S.apply_work(R.report.inner.iterations) + R.choice_fine_matvecs;
   R.peak_memory = Comm::world().max(peak_memory_bytes());  // several ranks: the largest rank's
+
   // A failed Coulomb Newton solve is redone as the fixed point of Tresca
   // solves (each globalised by the line search), its work and time added to
   // the new run's
   const bool coulomb_failed = R.coulomb() && opt.friction.method != FrictionLaw::CoulombMethod::fixed_point &&
                               (R.newton.reason == NewtonReason::stagnation || R.newton.reason == NewtonReason::iteration_limit);
-  if (coulomb_failed) {
-    RunOptions f = opt;
-    f.friction.method = FrictionLaw::CoulombMethod::fixed_point;
-    if (opt.phase_done)
-      opt.phase_done("Coulomb: one Newton solve did not converge; again by the fixed point", R.times.total);
-    RunResult again = run_tresca(spec, f);
-    again.coulomb_fallback = true;
-    again.fine_matvecs_total += R.fine_matvecs_total;
-    again.times.total += R.times.total;
-    return again;
-  }
-  return R;
+  if (!coulomb_failed) return R;
+  RunOptions f = opt;
+  f.friction.method = FrictionLaw::CoulombMethod::fixed_point;
+  if (opt.phase_done) opt.phase_done("Coulomb: one Newton solve did not converge; again by the fixed point", R.times.total);
+  RunResult again = run_tresca(spec, f);
+  again.coulomb_fallback = true;
+  again.fine_matvecs_total += R.fine_matvecs_total;
+  again.times.total += R.times.total;
+  return again;
 }
 
 }  // namespace tresca

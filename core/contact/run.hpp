@@ -58,8 +58,8 @@ struct RunOptions {
   index nested_min_contact_nodes = 64;
   // the coarse meshes stop at |v̂| <= nested_rtol |v̂_0| (their solutions
   // differ from the fine one by the discretisation error anyway) and
-  // compute r = S u - b̃ to 1e-3 nested_rtol (1e-3 rather than 1e-4: 1-2 %
-  // less work at levels 7-12, fine Newton steps unchanged; perf/RESULTS.md)
+  // compute r = S u - b̃ to 1e-3 nested_rtol (chosen by measurement:
+  // perf/RESULTS.md §0i)
   real nested_rtol = 1e-3;
   real tight_rtol = 1e-12;
   // the final check's verdict: KKT in consistent units within

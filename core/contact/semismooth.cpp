@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -273,6 +274,8 @@ bool stagnated(const std::vector<real>& h, int w) {
   return last > 0.5 * before;
 }
 
+namespace {
+
 // the initial iterates' sizes, and every node's bound and gap: throws
 // std::invalid_argument naming what is wrong
 void check_inputs(index p, index nf, const ContactConditions& law, const NewtonOptions& opt) {
@@ -343,16 +346,76 @@ real line_search(const std::vector<real>& merits, int memory, int halvings, cons
   return 0;
 }
 
-NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt) {
+// One semismooth* Newton solve (semismooth_newton): its state and its steps.
+class NewtonSolve {
+ public:
+  NewtonSolve(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt);
+  NewtonResult run();
+
+ private:
+  // the scratch of one evaluation of the approximation step (a trial point
+  // of the line search has its own law: Coulomb's bound of a rejected trial
+  // must not outlive it)
+  struct Point {
+    std::vector<real> u, lambda, r, v, w, d;
+    std::vector<std::uint8_t> status;
+    ContactConditions law;
+  };
+  NewtonResult finish(NewtonReason reason);
+  bool start();
+  bool refresh(real rtol);
+  ResidualNorms residual_at(ContactConditions& at, const std::vector<real>& u, const std::vector<real>& lambda,
+                            const std::vector<real>& r, std::vector<real>& vv, std::vector<real>& dd,
+                            std::vector<std::uint8_t>& st);
+  bool measure(int k);
+  std::optional<NewtonReason> record(int k);
+  std::optional<NewtonReason> newton_step();
+  std::optional<NewtonReason> take_step();
+
+  const SteklovPoincare& S;
+  const NewtonOptions& opt;
+  ContactConditions law;
+  const double t0;
+  const index p, n3, nf;
+  InnerWork work;
+  NewtonResult R;
+  real fscale = 1;  // |b̃|
+  real r_err = 0;   // bounds the error of the current r
+  const real* scale_ptr = nullptr;  // the step's metric (nullptr: the paper's s = 1)
+  const real* units = nullptr;      // the diagonal metric of the residual in consistent units
+  Point trial;
+  // side: [S Δu | E Δu] of the step; known_side: the same of its known increments
+  std::vector<real> v, d, du, side, known_side, dlambda;
+  ReducedSystem L;
+  std::unique_ptr<BoundaryPreconditioner> M;
+  CGWorkspace ws;
+  real smax = 0;  // |S x| <= smax |x|
+  bool last_step_hit_limit = false;
+  real eta;
+  // this iteration's |v̂|, merit |w| and tolerance
+  real vnorm = 0, merit = 0, tol = 0;
+};
+
+NewtonSolve::NewtonSolve(const SteklovPoincare& S_, const ContactConditions& given, const NewtonOptions& opt_)
+    : S(S_),
+      opt(opt_),
+      law(given),
+      t0(wall_time()),
+      p(S_.size() / 3),
+      n3(3 * p),
+      nf(S_.full_size()),
+      v(4 * p),
+      d(3 * p),
+      du(n3),
+      side(n3 + nf),
+      known_side(n3 + nf),
+      dlambda(p),
+      L(n3),
+      eta(opt_.forcing_max) {
   // Coulomb: the bound follows lambda at every iteration
   if (opt.friction.is_coulomb() && !opt.friction.bound_follows_lambda())
     throw std::invalid_argument("semismooth_newton: a Coulomb fixed point runs whole Tresca solves (coulomb.hpp)");
-  ContactConditions law = given;
-  const double t0 = wall_time();
-  const index p = S.size() / 3, n3 = 3 * p, nf = S.full_size();
   check_inputs(p, nf, law, opt);
-  InnerWork work;
-  NewtonResult R;
   R.u.assign(n3, 0);
   R.lambda.assign(p, 0);
   R.r.assign(n3, 0);
@@ -363,183 +426,197 @@ NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions
   R.units = step_scale(S);
   R.stop = opt.stop;
   R.kink_contact = opt.kink_contact;
-  const std::vector<real>& diagonal_scale = R.units;
-  if (opt.scaling == StepScaling::diagonal) R.scale = diagonal_scale;
-  const std::vector<real>& scale = R.scale;
-  auto finish = [&](NewtonReason reason) {
-    R.reason = reason;
-    R.phi = law.phi;
-    R.inner_iterations = work.iterations;
-    R.fine_matvecs = work.fine_matvecs;
-    return R;
-  };
+  if (opt.scaling == StepScaling::diagonal) R.scale = R.units;
+  scale_ptr = R.scale.empty() ? nullptr : R.scale.data();
+  // the residual in consistent units is measured in the stiffness of the
+  // diagonal metric whatever the step's metric
+  units = R.units.data();
   if (opt.u0) R.u = *opt.u0;
   if (opt.lambda0) R.lambda = *opt.lambda0;
   if (opt.body0)
     R.body = *opt.body0;
   else
     R.body.assign(nf, 0);
-  // r = S u - b̃ to the accuracy its use needs (Tolerances), by a solve
-  // warm from the body (refresh); r_err bounds the error of the current r
-  auto refresh = [&](real rtol) {
-    R.operator_applications += 1;
-    return work.residual(S, R.u.data(), R.r.data(), std::max(rtol, real(1e-12)), R.body.data(), R.body.data());
-  };
-  if (opt.r0) {
-    R.r = *opt.r0;
-  } else if (!refresh(opt.initial_residual_rtol)) {
-    return finish(NewtonReason::inner_failure);
-  }
-  // |b̃| given, or from x0 = 0, where r0 = -b̃ (1 if there is no load at all)
-  R.force_scale = opt.force_scale > 0 ? opt.force_scale : std::sqrt(S.sum(dot(n3, R.r.data(), R.r.data())));
-  if (!(R.force_scale > 0)) R.force_scale = 1;
-  const real fscale = R.force_scale;
-  real r_err = (opt.r0 ? (opt.r0_accuracy > 0 ? opt.r0_accuracy : opt.residual_accuracy) : opt.initial_residual_rtol) *
-               fscale;
-
-  const real* scale_ptr = scale.empty() ? nullptr : scale.data();
-  // a trial point of the line search (with its own law: Coulomb's bound of
-  // a rejected trial must not outlive it) and the approximation step's scratch
-  struct Trial {
-    std::vector<real> u, lambda, r, v, w, d;
-    std::vector<std::uint8_t> status;
-    ContactConditions law;
-  } trial{std::vector<real>(n3), std::vector<real>(p), std::vector<real>(n3), std::vector<real>(4 * p),
-          std::vector<real>(4 * p), std::vector<real>(3 * p), std::vector<std::uint8_t>(p), law};
-  // side: [S Δu | E Δu] of the step; known_side: the same of its known increments
-  std::vector<real> v(4 * p), d(3 * p), du(n3), side(n3 + nf), known_side(n3 + nf), dlambda(p);
-  // the residual in consistent units is measured in the stiffness of the
-  // diagonal metric whatever the step's metric
-  const real* units = diagonal_scale.data();
-  // the approximation step at (u, lambda, r) with the bound of `at` (Coulomb:
-  // phi_i = F lambda_i of that iterate): v̂, d and status into the given arrays
-  auto residual_at = [&](ContactConditions& at, const std::vector<real>& u, const std::vector<real>& lambda,
-                         const std::vector<real>& r, std::vector<real>& vv, std::vector<real>& dd,
-                         std::vector<std::uint8_t>& st) {
-    if (opt.friction.bound_follows_lambda()) at.set_coulomb_bound(opt.friction.F, lambda);
-    return approximation_step(p, at.law(opt.kink_contact), scale_ptr, units, u.data(), lambda.data(), r.data(),
-                              vv.data(), trial.w.data(), dd.data(), st.data());
-  };
-  ReducedSystem L(n3);
-  std::unique_ptr<BoundaryPreconditioner> M;
+  trial = Point{std::vector<real>(n3), std::vector<real>(p),    std::vector<real>(n3),         std::vector<real>(4 * p),
+                std::vector<real>(4 * p), std::vector<real>(3 * p), std::vector<std::uint8_t>(p), law};
   if (opt.outer_pc == OuterPreconditioner::multigrid)
     M = std::make_unique<BoundaryPreconditioner>(S, S.mg_options());
-  CGWorkspace ws;
-  // |S x| <= smax |x|: S <= K_cc, whose largest eigenvalue is below 4 times
-  // its largest diagonal entry (Gershgorin: the off-diagonal row sums of the
-  // Q1 elasticity stencil are 2-3 times the diagonal)
-  real smax = 0;
-  for (real sc : diagonal_scale) smax = std::max(smax, sc);
+  // S <= K_cc, whose largest eigenvalue is below 4 times its largest
+  // diagonal entry (Gershgorin: the off-diagonal row sums of the Q1
+  // elasticity stencil are 2-3 times the diagonal)
+  for (real sc : R.units) smax = std::max(smax, sc);
   smax = 4 * S.max(smax);
+}
 
-  bool last_step_hit_limit = false;
-  real eta = opt.forcing_max;
-  for (int k = 0;; ++k) {
-    // 1. approximation step at x = (u, lambda), r = S u - b̃, and the step's
-    // forcing term; r is refreshed first if it is not accurate enough for
-    // them (Tolerances)
-    real vnorm, merit, eta_k, tol;
-    for (int pass = 0;; ++pass) {
-      {
-        ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
-        const ResidualNorms norms = residual_at(law, R.u, R.lambda, R.r, v, d, R.status);
-        merit = std::sqrt(S.sum(norms.consistent));
-        vnorm = opt.stop == StopRule::consistent ? merit : std::sqrt(S.sum(norms.paper));
-        if (opt.friction.differentiates_bound()) {
-          // the step's point on the Coulomb graph: its pressure d_4 sets the
-          // bound of its friction force (v̂, the residual, stays at lambda)
-          for (index i = 0; i < p; ++i) law.phi[i] = opt.friction.F * d[2 * p + i];
-          approximation_step(p, law.law(opt.kink_contact), scale_ptr, units, R.u.data(), R.lambda.data(), R.r.data(),
-                             trial.v.data(), trial.w.data(), d.data(), R.status.data());
-        }
+NewtonResult NewtonSolve::finish(NewtonReason reason) {
+  R.reason = reason;
+  R.phi = law.phi;
+  R.inner_iterations = work.iterations;
+  R.fine_matvecs = work.fine_matvecs;
+  return std::move(R);
+}
+
+// r = S u - b̃ to the accuracy its use needs (Tolerances), by a solve warm
+// from the body
+bool NewtonSolve::refresh(real rtol) {
+  R.operator_applications += 1;
+  return work.residual(S, R.u.data(), R.r.data(), std::max(rtol, real(1e-12)), R.body.data(), R.body.data());
+}
+
+// the first residual and |b̃| (given, or from x0 = 0, where r0 = -b̃; 1 if
+// there is no load at all)
+bool NewtonSolve::start() {
+  if (opt.r0)
+    R.r = *opt.r0;
+  else if (!refresh(opt.initial_residual_rtol))
+    return false;
+  R.force_scale = opt.force_scale > 0 ? opt.force_scale : std::sqrt(S.sum(dot(n3, R.r.data(), R.r.data())));
+  if (!(R.force_scale > 0)) R.force_scale = 1;
+  fscale = R.force_scale;
+  r_err = (opt.r0 ? (opt.r0_accuracy > 0 ? opt.r0_accuracy : opt.residual_accuracy) : opt.initial_residual_rtol) *
+          fscale;
+  return true;
+}
+
+// the approximation step at (u, lambda, r) with the bound of `at` (Coulomb:
+// phi_i = F lambda_i of that iterate): v̂, d and status into the given arrays
+ResidualNorms NewtonSolve::residual_at(ContactConditions& at, const std::vector<real>& u,
+                                       const std::vector<real>& lambda, const std::vector<real>& r,
+                                       std::vector<real>& vv, std::vector<real>& dd, std::vector<std::uint8_t>& st) {
+  if (opt.friction.bound_follows_lambda()) at.set_coulomb_bound(opt.friction.F, lambda);
+  return approximation_step(p, at.law(opt.kink_contact), scale_ptr, units, u.data(), lambda.data(), r.data(),
+                            vv.data(), trial.w.data(), dd.data(), st.data());
+}
+
+// 1. the approximation step at x = (u, lambda), r = S u - b̃, and the step's
+// forcing term; r is refreshed first if it is not accurate enough for them
+// (Tolerances). False: an inner solve failed.
+bool NewtonSolve::measure(int k) {
+  real eta_k = eta;
+  for (int pass = 0;; ++pass) {
+    {
+      ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
+      const ResidualNorms norms = residual_at(law, R.u, R.lambda, R.r, v, d, R.status);
+      merit = std::sqrt(S.sum(norms.consistent));
+      vnorm = opt.stop == StopRule::consistent ? merit : std::sqrt(S.sum(norms.paper));
+      if (opt.friction.differentiates_bound()) {
+        // the step's point on the Coulomb graph: its pressure d_4 sets the
+        // bound of its friction force (v̂, the residual, stays at lambda)
+        for (index i = 0; i < p; ++i) law.phi[i] = opt.friction.F * d[2 * p + i];
+        approximation_step(p, law.law(opt.kink_contact), scale_ptr, units, R.u.data(), R.lambda.data(), R.r.data(),
+                           trial.v.data(), trial.w.data(), d.data(), R.status.data());
       }
-      tol = std::max(opt.eps, opt.rtol * (k == 0 ? vnorm : R.history[0]));
-      eta_k = forcing_term(opt, k, vnorm, k > 0 ? R.history[k - 1] : vnorm, eta, tol);
-      // r must be accurate to a fraction of what the step resolves, and to
-      // the full accuracy before |v̂| <= tol is believed
-      const real need = vnorm <= tol ? opt.residual_accuracy * fscale
-                                     : std::max(opt.residual_accuracy * fscale, opt.residual_fraction * eta_k * vnorm);
-      // (a refresh lowers |v̂| where r's error was most of it, and so the
-      // need: a few passes, each continuing the last solve)
-      if (r_err <= need || pass == 6 || !std::isfinite(vnorm)) break;
-      if (!refresh(need / fscale)) return finish(NewtonReason::inner_failure);
-      r_err = need;
     }
-    eta = eta_k;
-    R.tolerance = tol;
-    R.history.push_back(vnorm);
-    R.merit.push_back(merit);
-    R.inner_history.push_back(work.iterations);
-    R.outer_history.push_back(R.outer_iterations);
-    if (opt.progress) report_progress(S, R, law, k, vnorm, work.iterations, wall_time() - t0, opt.progress);
-    if (!std::isfinite(vnorm)) return finish(NewtonReason::non_finite);
-    if (vnorm <= tol) return finish(NewtonReason::converged);
-    if (k >= opt.max_iterations) return finish(NewtonReason::iteration_limit);
-    if (stagnated(R.merit, opt.stagnation_window)) return finish(NewtonReason::stagnation);
+    tol = std::max(opt.eps, opt.rtol * (k == 0 ? vnorm : R.history[0]));
+    eta_k = forcing_term(opt, k, vnorm, k > 0 ? R.history[k - 1] : vnorm, eta, tol);
+    // r must be accurate to a fraction of what the step resolves, and to
+    // the full accuracy before |v̂| <= tol is believed
+    const real need = vnorm <= tol ? opt.residual_accuracy * fscale
+                                   : std::max(opt.residual_accuracy * fscale, opt.residual_fraction * eta_k * vnorm);
+    // (a refresh lowers |v̂| where r's error was most of it, and so the
+    // need: a few passes, each continuing the last solve)
+    if (r_err <= need || pass == 6 || !std::isfinite(vnorm)) break;
+    if (!refresh(need / fscale)) return false;
+    r_err = need;
+  }
+  eta = eta_k;
+  return true;
+}
 
-    // 2. linearisation: known increments, free set, H, right-hand side
-    // (any rank's known increments make every rank apply S to them: S is collective)
-    const bool any_known = S.max(linearise(p, law, scale_ptr, R.u, R.lambda, R.status, v, d,
-                                           opt.friction, L)
-                                     ? 1
-                                     : 0) > 0;
+// the iteration's record and progress line, and whether it stops here
+std::optional<NewtonReason> NewtonSolve::record(int k) {
+  R.tolerance = tol;
+  R.history.push_back(vnorm);
+  R.merit.push_back(merit);
+  R.inner_history.push_back(work.iterations);
+  R.outer_history.push_back(R.outer_iterations);
+  if (opt.progress) report_progress(S, R, law, k, vnorm, work.iterations, wall_time() - t0, opt.progress);
+  if (!std::isfinite(vnorm)) return NewtonReason::non_finite;
+  if (vnorm <= tol) return NewtonReason::converged;
+  if (k >= opt.max_iterations) return NewtonReason::iteration_limit;
+  if (stagnated(R.merit, opt.stagnation_window)) return NewtonReason::stagnation;
+  return std::nullopt;
+}
 
-    // 3. the reduced Newton system, by preconditioned CG on the boundary
-    const StepOutcome step =
-        solve_step(S, L, M.get(), eta, 0.1 * tol, smax, any_known, work, ws, du, side, known_side);
-    R.outer_iterations += step.outer.iterations;
-    R.operator_applications += step.outer.iterations + (step.known_applied ? 1 : 0);
-    if (step.inner_failed) return finish(NewtonReason::inner_failure);
-    if (step.outer.reason == SolveReason::non_finite) return finish(NewtonReason::non_finite);
-    if (step.outer.reason == SolveReason::breakdown) return finish(NewtonReason::inner_failure);
-    const bool limit = step.outer.reason == SolveReason::max_iterations;
-    if (limit) R.outer_limit_hits += 1;  // inexact step taken
-    if (limit && last_step_hit_limit) return finish(NewtonReason::outer_failure);
-    last_step_hit_limit = limit;
+// 2. linearisation: known increments, free set, H, right-hand side, and
+// 3. the reduced Newton system, by preconditioned CG on the boundary
+std::optional<NewtonReason> NewtonSolve::newton_step() {
+  // (any rank's known increments make every rank apply S to them: S is collective)
+  const bool any_known =
+      S.max(linearise(p, law, scale_ptr, R.u, R.lambda, R.status, v, d, opt.friction, L) ? 1 : 0) > 0;
+  const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * tol, smax, any_known, work, ws, du, side, known_side);
+  R.outer_iterations += step.outer.iterations;
+  R.operator_applications += step.outer.iterations + (step.known_applied ? 1 : 0);
+  if (step.inner_failed) return NewtonReason::inner_failure;
+  if (step.outer.reason == SolveReason::non_finite) return NewtonReason::non_finite;
+  if (step.outer.reason == SolveReason::breakdown) return NewtonReason::inner_failure;
+  const bool limit = step.outer.reason == SolveReason::max_iterations;
+  if (limit) R.outer_limit_hits += 1;  // inexact step taken
+  if (limit && last_step_hit_limit) return NewtonReason::outer_failure;
+  last_step_hit_limit = limit;
+  return std::nullopt;
+}
 
-    // 4. update x = (u, lambda), r = S u - b̃ and the body. The step may be
-    // inexact, but S Δu must be as accurate as this step's r (its error
-    // stays in every later r): one application of S to the whole Δu, its
-    // inner solve warm from the CG's running E Δu, to an absolute accuracy
-    // of max(residual_accuracy |b̃|, residual_fraction eta_k |v̂_k|). An
-    // increment has the rounding error of its own size, not of r's, so r is
-    // kept by increments and refreshed only where it is too loose.
-    for (index i = 0; i < n3; ++i) du[i] += L.known[i];
-    real* Sdu = side.data();
-    real* Edu = side.data() + n3;
-    const real accuracy = std::max(opt.residual_accuracy * fscale, opt.residual_fraction * eta * vnorm);
-    // |S Δu| from the CG's side product, or (GMRES) bounded by max s |Δu|
-    const real sdu_norm = L.coupled ? smax * std::sqrt(S.sum(dot(n3, du.data(), du.data())))
-                                    : std::sqrt(S.sum(dot(n3, Sdu, Sdu)));
-    const real inc_rtol = sdu_norm > 0 ? std::clamp(accuracy / sdu_norm, real(1e-12), real(1e-1)) : real(1e-1);
-    R.operator_applications += 1;
-    if (!work.apply(S, du.data(), Sdu, inc_rtol, Edu, Edu)) return finish(NewtonReason::inner_failure);
-    r_err = std::max(r_err, accuracy);
-    for (index i = 0; i < p; ++i) dlambda[i] = L.dlambda[i] + ((R.status[i] & kContact) ? Sdu[2 * p + i] : 0);
+// 4. update x = (u, lambda), r = S u - b̃ and the body. The step may be
+// inexact, but S Δu must be as accurate as this step's r (its error stays
+// in every later r): one application of S to the whole Δu, its inner solve
+// warm from the CG's running E Δu, to an absolute accuracy of
+// max(residual_accuracy |b̃|, residual_fraction eta_k |v̂_k|). An increment
+// has the rounding error of its own size, not of r's, so r is kept by
+// increments and refreshed only where it is too loose.
+// 5. the step's length: the non-monotone line search on the merit |w|
+// (NewtonOptions::line_search); r, lambda and u are linear along it.
+std::optional<NewtonReason> NewtonSolve::take_step() {
+  for (index i = 0; i < n3; ++i) du[i] += L.known[i];
+  real* Sdu = side.data();
+  real* Edu = side.data() + n3;
+  const real accuracy = std::max(opt.residual_accuracy * fscale, opt.residual_fraction * eta * vnorm);
+  // |S Δu| from the CG's side product, or (GMRES) bounded by max s |Δu|
+  const real sdu_norm = L.coupled ? smax * std::sqrt(S.sum(dot(n3, du.data(), du.data())))
+                                  : std::sqrt(S.sum(dot(n3, Sdu, Sdu)));
+  const real inc_rtol = sdu_norm > 0 ? std::clamp(accuracy / sdu_norm, real(1e-12), real(1e-1)) : real(1e-1);
+  R.operator_applications += 1;
+  if (!work.apply(S, du.data(), Sdu, inc_rtol, Edu, Edu)) return NewtonReason::inner_failure;
+  r_err = std::max(r_err, accuracy);
+  for (index i = 0; i < p; ++i) dlambda[i] = L.dlambda[i] + ((R.status[i] & kContact) ? Sdu[2 * p + i] : 0);
 
-    // 5. the step's length: the non-monotone line search on the merit |w|
-    // (NewtonOptions::line_search); r, lambda and u are linear along it
-    real alpha = 1;
-    if (opt.line_search) {
-      alpha = line_search(R.merit, opt.line_search_memory, opt.line_search_halvings, [&](real a) {
-        for (index i = 0; i < n3; ++i) {
-          trial.u[i] = R.u[i] + a * du[i];
-          trial.r[i] = R.r[i] + a * Sdu[i];
-        }
-        for (index i = 0; i < p; ++i) trial.lambda[i] = R.lambda[i] + a * dlambda[i];
-        ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
-        return std::sqrt(
-            S.sum(residual_at(trial.law, trial.u, trial.lambda, trial.r, trial.v, trial.d, trial.status).consistent));
-      });
-      if (alpha == 0) return finish(NewtonReason::stagnation);
-    }
-    R.step_lengths.push_back(alpha);
-    axpy(p, alpha, dlambda.data(), R.lambda.data());
-    axpy(n3, alpha, du.data(), R.u.data());
-    axpy(n3, alpha, Sdu, R.r.data());
-    axpy(nf, alpha, Edu, R.body.data());
+  real alpha = 1;
+  if (opt.line_search) {
+    alpha = line_search(R.merit, opt.line_search_memory, opt.line_search_halvings, [&](real a) {
+      for (index i = 0; i < n3; ++i) {
+        trial.u[i] = R.u[i] + a * du[i];
+        trial.r[i] = R.r[i] + a * Sdu[i];
+      }
+      for (index i = 0; i < p; ++i) trial.lambda[i] = R.lambda[i] + a * dlambda[i];
+      ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
+      return std::sqrt(
+          S.sum(residual_at(trial.law, trial.u, trial.lambda, trial.r, trial.v, trial.d, trial.status).consistent));
+    });
+    if (alpha == 0) return NewtonReason::stagnation;
+  }
+  R.step_lengths.push_back(alpha);
+  axpy(p, alpha, dlambda.data(), R.lambda.data());
+  axpy(n3, alpha, du.data(), R.u.data());
+  axpy(n3, alpha, Sdu, R.r.data());
+  axpy(nf, alpha, Edu, R.body.data());
+  return std::nullopt;
+}
+
+NewtonResult NewtonSolve::run() {
+  if (!start()) return finish(NewtonReason::inner_failure);
+  for (int k = 0;; ++k) {
+    if (!measure(k)) return finish(NewtonReason::inner_failure);
+    if (const auto stop = record(k)) return finish(*stop);
+    if (const auto failed = newton_step()) return finish(*failed);
+    if (const auto failed = take_step()) return finish(*failed);
     R.iterations = k + 1;
   }
+}
+
+}  // namespace
+
+NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt) {
+  return NewtonSolve(S, given, opt).run();
 }
 
 }  // namespace tresca

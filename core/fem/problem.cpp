@@ -191,8 +191,8 @@ double estimated_memory_bytes(const ProblemSpec& s) {
   // fine-grid vectors of 3n doubles: load 1, Steklov buffers 3, inner CG 4,
   // two multigrid hierarchies 2 x (r, d, dinv) + coarse copies, boundary
   // preconditioner 2, Newton's body and the step's extensions 4, set-up
-  // temporaries; 22 x (1 + 1/7) = 25.1 of them bounds the measured peak,
-  // coarse levels included (perf/RESULTS.md §5)
+  // temporaries; 22 x (1 + 1/7) of them, coarse levels included, bound the
+  // measured peak (perf/RESULTS.md §0i)
   return 22.0 * 3 * n * 8 * (1 + 1.0 / 7);
 }
 

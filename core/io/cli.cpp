@@ -1,6 +1,7 @@
 #include "core/io/cli.hpp"
 
 #include "core/parallel/comm.hpp"
+#include "kernels/simd.hpp"
 
 #include <algorithm>
 #include <utility>
@@ -12,6 +13,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 #include <stdexcept>
@@ -36,7 +38,8 @@ Args::Args(int argc, char** argv, const std::set<std::string>& flags, const std:
       v = k.substr(eq + 1);
       k = k.substr(0, eq);
     }
-    if (switches.count(k)) {
+    if (k == "-h") k = "--help";
+    if (switches.count(k) || k == "--help" || k == "--version") {
       if (inline_value) fail("option " + k + " takes no value");
       values_[k] = "1";
     } else if (flags.count(k)) {
@@ -53,6 +56,16 @@ Args::Args(int argc, char** argv, const std::set<std::string>& flags, const std:
       fail("unknown option " + quoted(k) + " (see --help)");
     }
   }
+}
+
+bool answered_help_or_version(const Args& a, const char* program, const char* help) {
+  if (!a.has("--help") && !a.has("--version")) return false;
+  if (Comm::world().rank() == 0) std::fputs(a.has("--help") ? help : version_text(program).c_str(), stdout);
+  return true;
+}
+
+std::string version_text(const char* program) {
+  return std::string(program) + " (tresca-ssn) " TRESCA_VERSION " (" TRESCA_COMMIT ")\nbuild: " + build_info() + "\n";
 }
 
 std::string Args::str(const std::string& k, const std::string& def) const {

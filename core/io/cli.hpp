@@ -13,7 +13,9 @@ namespace tresca {
 
 class Args {
  public:
-  // flags: options taking a value ("--level"); switches: options without ("--quiet")
+  // flags: options taking a value ("--level"); switches: options without
+  // ("--quiet"). Every driver also takes -h / --help and --version
+  // (answered_help_or_version).
   Args(int argc, char** argv, const std::set<std::string>& flags, const std::set<std::string>& switches);
   bool has(const std::string& k) const { return values_.count(k) > 0; }
   std::string str(const std::string& k, const std::string& def = "") const;
@@ -23,6 +25,13 @@ class Args {
  private:
   std::map<std::string, std::string> values_;
 };
+
+// -h / --help: prints `help` (the driver's full usage); --version: the
+// program, the project's version and commit, and the build (ISA, vector
+// width, compiler and its target options). True if either was asked: the
+// driver then exits with status 0.
+bool answered_help_or_version(const Args& a, const char* program, const char* help);
+std::string version_text(const char* program);
 
 // "--level L" or "--dims AxBxC" (exactly one; default level), plus --E, --nu, --phi.
 // the problem from the command line, over `base` (a problem file's) when

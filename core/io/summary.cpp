@@ -1,5 +1,7 @@
 #include "core/io/summary.hpp"
 
+#include "core/util/profile.hpp"
+
 #include "core/parallel/comm.hpp"
 
 #include <cmath>
@@ -95,6 +97,17 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["true_residual_relative"] = F.true_residual_relative;
   j["true_residual_within_eps"] = F.true_residual <= eps;
   j["true_residual_resolution"] = F.resolution;  // r is known to about this [N]
+  // the kernel profile of the run (core/util/profile.hpp; shares of the total add up to 1 with "other")
+  Json profile = Json::array();
+  for (const ProfileRow& r : profile_rows(R.times.total))
+    profile.push_back({{"kernel", r.kernel},
+                       {"calls", r.calls},
+                       {"seconds", r.seconds},
+                       {"self_seconds", r.self_seconds},
+                       {"share", r.share},
+                       {"bytes_per_s", r.bytes_per_s},
+                       {"flops_per_s", r.flops_per_s}});
+  j["profile"] = profile;
   j["times"] = {{"nested", R.times.nested}, {"setup", R.times.setup},   {"condense", R.times.condense},
                 {"solve", R.times.solve},   {"recover", R.times.recover}, {"total", R.times.total}};
   j["counts"] = {{"inner_iterations", R.inner_iterations},

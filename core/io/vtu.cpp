@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "kernels/contact_maps.hpp"
+#include "kernels/element.hpp"
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the VTU writer declares byte_order=\"LittleEndian\"");
 
@@ -105,12 +106,23 @@ std::vector<unsigned char> compressed(const std::vector<unsigned char>& raw) {
   return blob;
 }
 
+// What the arrays mean, in every file (an XML comment: readers skip it).
+const char* kLegend =
+    "<!-- tresca: SI units (m, N, Pa); the mesh is the undeformed body (ParaView: Warp By Vector with\n"
+    "     displacement draws it deformed). Point data: displacement [m]; contact_force [N], the nodal\n"
+    "     force of the contact on a contact node (x, y: friction; z: the normal force lambda), 0 elsewhere;\n"
+    "     contact_pressure [Pa], lambda over the node's share of the contact face's area;\n"
+    "     contact_status: 0 not a contact node (the clamped edge x = x0 or off the face), 1 separated,\n"
+    "     2 stick, 3 slip. Cell data (body): stress [Pa], the Cauchy stress at the cell's centre (xx, yy,\n"
+    "     zz, xy, yz, xz); von_mises [Pa]. See docs/outputs.md. -->\n";
+
 // One piece of an unstructured grid: points, cells of one VTK type, point data.
 struct Piece {
   index points = 0, cells = 0;
   std::vector<Array> geometry;    // Points
   std::vector<Array> topology;    // Cells: connectivity, offsets, types
   std::vector<Array> point_data;  // the first one is the vector field shown
+  std::vector<Array> cell_data;   // the first one is the tensor shown, the second the scalar
 
   Piece(const std::vector<double>& xyz, const std::vector<index>& conn, int per_cell, std::uint8_t vtk_type)
       : points(index(xyz.size() / 3)), cells(index(conn.size()) / per_cell) {
@@ -134,6 +146,7 @@ struct Piece {
                  "byte_order=\"LittleEndian\" header_type=\"UInt64\"%s>\n<UnstructuredGrid>\n<Piece "
                  "NumberOfPoints=\"%lld\" NumberOfCells=\"%lld\">\n",
                  bin ? " compressor=\"vtkLZMADataCompressor\"" : "", (long long)points, (long long)cells);
+    std::fputs(kLegend, f);
     std::vector<std::vector<unsigned char>> blobs;
     std::uint64_t offset = 0;
     auto section = [&](const char* tag, const std::vector<Array>& arrays, const char* attrs) {
@@ -158,6 +171,10 @@ struct Piece {
     section("Cells", topology, "");
     const std::string shown = " Vectors=\"" + point_data.front().name + "\"";
     section("PointData", point_data, shown.c_str());
+    if (!cell_data.empty()) {
+      const std::string cshown = " Tensors=\"" + cell_data[0].name + "\" Scalars=\"" + cell_data[1].name + "\"";
+      section("CellData", cell_data, cshown.c_str());
+    }
     std::fprintf(f, "</Piece>\n</UnstructuredGrid>\n");
     if (bin) {
       std::fprintf(f, "<AppendedData encoding=\"raw\">\n_");
@@ -175,6 +192,13 @@ int status_code(std::uint8_t s) { return 1 + int(contact_state(s)); }
 
 namespace {
 
+// the area of the contact face that contact node (ix, iy) stands for: a
+// quarter of each face quad it is a corner of [m^2]
+double nodal_area(const GridDims& g, index ix, index iy) {
+  const double wx = (ix == 0 || ix == g.ex) ? 0.5 : 1, wy = (iy == 0 || iy == g.ey) ? 0.5 : 1;
+  return wx * wy * g.hx() * g.hy();
+}
+
 // the per-node contact id of the bottom plane (-1: not a contact node)
 std::vector<index> contact_ids(const Problem& P) {
   const GridDims& g = P.grid;
@@ -191,7 +215,8 @@ void write_body(OutputSet& out, const std::string& path, const Problem& P, index
   const index p = P.contact_nodes(), nx = g.nx(), rows = r1 - r0, n_pts = nx * rows * g.nz(), Nu = ub.nodes();
   const std::vector<index> cid = contact_ids(P);
   auto local = [&](index ix, index iy, index iz) { return ix + nx * ((iy - r0) + rows * iz); };
-  std::vector<double> xyz(3 * size_t(n_pts)), disp(3 * size_t(n_pts)), force(3 * size_t(n_pts), 0.0);
+  std::vector<double> xyz(3 * size_t(n_pts)), disp(3 * size_t(n_pts)), force(3 * size_t(n_pts), 0.0),
+      pressure(size_t(n_pts), 0.0);
   std::vector<std::uint8_t> code(n_pts, 0);
   for (index iz = 0; iz < g.nz(); ++iz)
     for (index iy = r0; iy < r1; ++iy)
@@ -206,20 +231,35 @@ void write_body(OutputSet& out, const std::string& path, const Problem& P, index
             force[3 * n] = (*c.r)[i];
             force[3 * n + 1] = (*c.r)[p + i];
             force[3 * n + 2] = (*c.lambda)[i];
+            pressure[n] = (*c.lambda)[i] / nodal_area(g, ix, iy);
             code[n] = std::uint8_t(status_code((*c.status)[i]));
           }
       }
+  const index n_cells = g.ex * (rows - 1) * g.ez;
   std::vector<index> conn;
-  conn.reserve(size_t(8 * g.ex * (rows - 1) * g.ez));
+  conn.reserve(size_t(8 * n_cells));
+  std::vector<double> stress(6 * size_t(n_cells)), mises(static_cast<size_t>(n_cells));
   const int order[8] = {0, 1, 3, 2, 4, 5, 7, 6};  // VTK_HEXAHEDRON node order
+  index cell = 0;
   for (index ez = 0; ez < g.ez; ++ez)
     for (index ey = r0; ey + 1 < r1; ++ey)
-      for (index ex = 0; ex < g.ex; ++ex)
+      for (index ex = 0; ex < g.ex; ++ex, ++cell) {
         for (int k : order) conn.push_back(local(ex + (k & 1), ey + ((k >> 1) & 1), ez + ((k >> 2) & 1)));
+        real ue[24];
+        for (int L = 0; L < 8; ++L) {
+          const index m = ub.node(ex + (L & 1), ey + ((L >> 1) & 1) - rb, ez + ((L >> 2) & 1));
+          for (int a = 0; a < 3; ++a) ue[3 * L + a] = u[a * Nu + m];
+        }
+        centroid_stress(g.hx(), g.hy(), g.hz(), P.spec.E, P.spec.nu, ue, &stress[6 * cell]);
+        mises[cell] = von_mises(&stress[6 * cell]);
+      }
   Piece body(xyz, conn, 8, 12);
   body.point_data.emplace_back(Array::Type::f64, "displacement", 3, disp);
   body.point_data.emplace_back(Array::Type::f64, "contact_force", 3, force);
+  body.point_data.emplace_back(Array::Type::f64, "contact_pressure", 1, pressure);
   body.point_data.emplace_back(Array::Type::u8, "contact_status", 1, code);
+  body.cell_data.emplace_back(Array::Type::f64, "stress", 6, stress);
+  body.cell_data.emplace_back(Array::Type::f64, "von_mises", 1, mises);
   body.write(out.create(path), format);
 }
 
@@ -229,7 +269,7 @@ void write_face(OutputSet& out, const std::string& path, const Problem& P, const
   const GridDims& g = P.grid;
   const index M = g.nx() * g.ny(), p = P.contact_nodes();
   const std::vector<index> cid = contact_ids(P);
-  std::vector<double> xyz(3 * size_t(M)), disp(3 * size_t(M), 0.0), lambda(M, 0.0);
+  std::vector<double> xyz(3 * size_t(M)), disp(3 * size_t(M), 0.0), force(3 * size_t(M), 0.0), pressure(M, 0.0);
   std::vector<std::uint8_t> code(M, 0);
   for (index n = 0; n < M; ++n) {
     xyz[3 * n] = g.x0 + (n % g.nx()) * g.hx();
@@ -237,7 +277,10 @@ void write_face(OutputSet& out, const std::string& path, const Problem& P, const
     xyz[3 * n + 2] = g.z0;
     if (const index i = cid[n]; i >= 0) {
       for (int a = 0; a < 3; ++a) disp[3 * n + a] = (*c.u)[a * p + i];
-      lambda[n] = (*c.lambda)[i];
+      force[3 * n] = (*c.r)[i];
+      force[3 * n + 1] = (*c.r)[p + i];
+      force[3 * n + 2] = (*c.lambda)[i];
+      pressure[n] = (*c.lambda)[i] / nodal_area(g, n % g.nx(), n / g.nx());
       code[n] = std::uint8_t(status_code((*c.status)[i]));
     }
   }
@@ -247,7 +290,8 @@ void write_face(OutputSet& out, const std::string& path, const Problem& P, const
       for (index k : {index(0), index(1), g.nx() + 1, g.nx()}) conn.push_back(ex + g.nx() * ey + k);
   Piece face(xyz, conn, 4, 9);
   face.point_data.emplace_back(Array::Type::f64, "displacement", 3, disp);
-  face.point_data.emplace_back(Array::Type::f64, "lambda", 1, lambda);
+  face.point_data.emplace_back(Array::Type::f64, "contact_force", 3, force);
+  face.point_data.emplace_back(Array::Type::f64, "contact_pressure", 1, pressure);
   face.point_data.emplace_back(Array::Type::u8, "contact_status", 1, code);
   face.write(out.create(path), format);
 }
@@ -277,7 +321,11 @@ std::string write_pvtu(OutputSet& out, const std::string& path, const Problem& P
       "header_type=\"UInt64\">\n<PUnstructuredGrid GhostLevel=\"0\">\n<PPointData Vectors=\"displacement\">\n"
       "<PDataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\"/>\n"
       "<PDataArray type=\"Float64\" Name=\"contact_force\" NumberOfComponents=\"3\"/>\n"
+      "<PDataArray type=\"Float64\" Name=\"contact_pressure\" NumberOfComponents=\"1\"/>\n"
       "<PDataArray type=\"UInt8\" Name=\"contact_status\" NumberOfComponents=\"1\"/>\n</PPointData>\n"
+      "<PCellData Tensors=\"stress\" Scalars=\"von_mises\">\n"
+      "<PDataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\"/>\n"
+      "<PDataArray type=\"Float64\" Name=\"von_mises\" NumberOfComponents=\"1\"/>\n</PCellData>\n"
       "<PPoints>\n<PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n</PPoints>\n";
   for (int q = 0; q < s.ranks; ++q) {
     std::string f = pvtu_piece_name(path, q);

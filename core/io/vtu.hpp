@@ -23,10 +23,14 @@ enum class VtkFormat { binary, ascii };
 // "binary" or "ascii"; throws std::invalid_argument naming `option` otherwise
 VtkFormat parse_vtk_format(const std::string& s, const std::string& option);
 
-// Body with point data displacement, contact_force and contact_status
-// (0 not a contact node, 1 separated, 2 contact+stick, 3 contact+slip); the
-// contact face (quads, with displacement, lambda and contact_status) goes to
-// vtu_companion(path). Returns the second file's path.
+// The body (the undeformed mesh) with point data displacement [m],
+// contact_force [N] (friction x, y and normal lambda on contact nodes),
+// contact_pressure [Pa] (lambda over the node's share of the face's area)
+// and contact_status (0 not a contact node, 1 separated, 2 stick, 3 slip),
+// and cell data stress [Pa] (Cauchy, at the cell's centre; xx yy zz xy yz
+// xz) and von_mises [Pa]; the contact face (quads, with the same point data)
+// goes to vtu_companion(path). Every file says so in an XML comment
+// (docs/outputs.md). Returns the second file's path.
 std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
                       const ContactFields& c, VtkFormat format = VtkFormat::binary);
 

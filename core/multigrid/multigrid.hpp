@@ -121,8 +121,8 @@ class Multigrid : public LinearOperator {
   // like: take the smoother's spectral bounds from that multigrid (its
   // hierarchy must be `grids`) instead of estimating them, for an operator
   // whose Jacobi-scaled spectrum is the same up to boundary terms (the K + B
-  // preconditioner of the Newton step against the K_ii solver: within 0.3 %,
-  // inside the 1.15 margin; perf/RESULTS.md)
+  // preconditioner of the Newton step against the K_ii solver, well inside
+  // the smoother's safety margin; perf/RESULTS.md §0i)
   Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt = {},
             const Multigrid* like = nullptr);
   // builds its own hierarchy (opt.coarse_nodes) for elasticity on `fine`

@@ -3,6 +3,7 @@
 #include <omp.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cstdio>
 
 namespace tresca {
@@ -26,37 +27,79 @@ double peak_memory_bytes() {
   return double(ru.ru_maxrss) * 1024.0;  // Linux reports kilobytes
 }
 
-void profile_add(Kernel k, double seconds, double bytes, double flops) {
+namespace {
+ScopedTimer* g_innermost = nullptr;
+}
+
+ScopedTimer::ScopedTimer(Kernel k, Cost cost)
+    : k_(k), b_(cost.bytes), f_(cost.flops), t0_(wall_time()), outer_(g_innermost) {
+  g_innermost = this;
+}
+
+ScopedTimer::~ScopedTimer() {
+  const double dt = wall_time() - t0_;
+  g_innermost = outer_;
+  if (outer_) outer_->nested_ += dt;
   // called from the serial driver thread only (kernels parallelise inside)
-  ProfileEntry& e = g_entries[int(k)];
+  ProfileEntry& e = g_entries[int(k_)];
   e.calls += 1;
-  e.seconds += seconds;
-  e.bytes += bytes;
-  e.flops += flops;
+  e.seconds += dt;
+  e.self_seconds += dt - nested_;
+  e.bytes += b_;
+  e.flops += f_;
+}
+
+void profile_reset() {
+  for (ProfileEntry& e : g_entries) e = ProfileEntry{};
+}
+
+std::vector<ProfileRow> profile_rows(double total) {
+  std::vector<ProfileRow> rows;
+  double counted = 0;
+  for (int i = 0; i < int(Kernel::count); ++i) {
+    const ProfileEntry& e = g_entries[i];
+    if (e.calls == 0) continue;
+    ProfileRow r;
+    r.kernel = kernel_name(Kernel(i));
+    r.calls = e.calls;
+    r.seconds = e.seconds;
+    r.self_seconds = e.self_seconds;
+    r.share = total > 0 ? e.self_seconds / total : 0;
+    // rows without a traffic model (they contain other rows) show no rates
+    if (e.seconds > 0 && e.bytes > 0) {
+      r.bytes_per_s = e.bytes / e.seconds;
+      r.flops_per_s = e.flops / e.seconds;
+    }
+    counted += e.self_seconds;
+    rows.push_back(r);
+  }
+  ProfileRow other;
+  other.kernel = "other";
+  other.seconds = other.self_seconds = std::max(0.0, total - counted);
+  other.share = total > 0 ? other.self_seconds / total : 0;
+  rows.push_back(other);
+  return rows;
 }
 
 std::string profile_table(double total) {
   std::string out;
   char line[256];
-  std::snprintf(line, sizeof line, "%-22s %10s %10s %7s %9s %9s\n", "kernel", "calls", "time [s]", "share",
-                "GB/s", "GFLOP/s");
+  std::snprintf(line, sizeof line, "%-22s %10s %10s %10s %7s %9s %9s\n", "kernel", "calls", "time [s]", "self [s]",
+                "share", "GB/s", "GFLOP/s");
   out += line;
-  for (int i = 0; i < int(Kernel::count); ++i) {
-    const ProfileEntry& e = g_entries[i];
-    if (e.calls == 0) continue;
-    // rows that contain other rows, or have no traffic model, show no rates
-    const bool nested = Kernel(i) == Kernel::inner_cg || Kernel(i) == Kernel::outer_cg ||
-                        Kernel(i) == Kernel::smoother || Kernel(i) == Kernel::coarse_solve;
-    char gbs[16] = "-", gflops[16] = "-";
-    if (!nested && e.seconds > 0) {
-      std::snprintf(gbs, sizeof gbs, "%.2f", e.bytes / e.seconds * 1e-9);
-      std::snprintf(gflops, sizeof gflops, "%.2f", e.flops / e.seconds * 1e-9);
+  for (const ProfileRow& r : profile_rows(total)) {
+    char gbs[16] = "-", gflops[16] = "-", calls[24] = "-";
+    if (r.bytes_per_s > 0) {
+      std::snprintf(gbs, sizeof gbs, "%.2f", r.bytes_per_s * 1e-9);
+      std::snprintf(gflops, sizeof gflops, "%.2f", r.flops_per_s * 1e-9);
     }
-    std::snprintf(line, sizeof line, "%-22s %10lld %10.3f %6.1f%% %9s %9s\n", kernel_name(Kernel(i)), e.calls,
-                  e.seconds, total > 0 ? 100 * e.seconds / total : 0.0, gbs, gflops);
+    if (r.calls > 0) std::snprintf(calls, sizeof calls, "%lld", r.calls);
+    std::snprintf(line, sizeof line, "%-22s %10s %10.3f %10.3f %6.1f%% %9s %9s\n", r.kernel.c_str(), calls, r.seconds,
+                  r.self_seconds, 100 * r.share, gbs, gflops);
     out += line;
   }
-  out += "(smoother, inner and outer CG rows contain the kernel rows; their shares overlap)\n";
+  out += "(time: the row's whole time; self: less the rows timed inside it, e.g. the smoother less its\n"
+         " applies; share: self / total, so the shares add up to 100 %; other: outside every timer)\n";
   return out;
 }
 

@@ -3,6 +3,7 @@
 // Timers are cheap (omp_get_wtime) and always on.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "kernels/types.hpp"
 
@@ -17,10 +18,24 @@ const char* kernel_name(Kernel k);
 struct ProfileEntry {
   long long calls = 0;
   double seconds = 0, bytes = 0, flops = 0;
+  double self_seconds = 0;  // less the time of the timers nested in it (smoother: less its applies)
 };
 
-void profile_add(Kernel k, double seconds, double bytes, double flops);
-// Table with calls, time, share of `total_seconds`, GB/s and GFLOP/s.
+// One row of the profile. Timers nest (an inner CG contains applies, the
+// smoother contains applies): `seconds` is a row's whole time, `self_seconds`
+// the part no nested row counts, and `share` = self / total, so the shares
+// of the rows and of "other" (outside every timer: setup, Newton's own
+// bookkeeping, output) add up to 100 %. Rates use the whole time and are 0
+// where a row has no traffic model.
+struct ProfileRow {
+  std::string kernel;
+  long long calls = 0;
+  double seconds = 0, self_seconds = 0, share = 0, bytes_per_s = 0, flops_per_s = 0;
+};
+std::vector<ProfileRow> profile_rows(double total_seconds);
+// forget what was timed so far (a driver running several solves: before each)
+void profile_reset();
+// the rows as a table: calls, time, self time, share, GB/s and GFLOP/s
 std::string profile_table(double total_seconds);
 
 double wall_time();
@@ -40,17 +55,21 @@ double best_time(int reps, F&& f) {
 // peak resident memory of this process so far, in bytes (getrusage)
 double peak_memory_bytes();
 
+// Times a scope as kernel k. Timers are made and ended on the driver's
+// (serial) thread, innermost last; each one knows the timer it runs in.
 class ScopedTimer {
  public:
   // cost: the kernel's modelled traffic and flops (n * kSomeCost)
-  explicit ScopedTimer(Kernel k, Cost cost = {}) : k_(k), b_(cost.bytes), f_(cost.flops), t0_(wall_time()) {}
-  ~ScopedTimer() { profile_add(k_, wall_time() - t0_, b_, f_); }
+  explicit ScopedTimer(Kernel k, Cost cost = {});
+  ~ScopedTimer();
   ScopedTimer(const ScopedTimer&) = delete;
   ScopedTimer& operator=(const ScopedTimer&) = delete;
 
  private:
   Kernel k_;
   double b_, f_, t0_;
+  double nested_ = 0;  // the time of the timers ended inside this one
+  ScopedTimer* outer_;
 };
 
 }  // namespace tresca
