@@ -125,6 +125,7 @@ struct Command {
   VtkFormat vtk_format = VtkFormat::binary;
   bool every_iteration = false, quiet = false, profile = false;
   std::vector<real> initial_u, initial_lambda;  // --initial: u0 (3p SoA), lambda0 (p)
+  std::vector<std::string> no_effect;  // options given that change nothing here (warned about)
 };
 
 // a failed write of an output: exit status 3
@@ -259,6 +260,9 @@ void parse_command(const Args& a, const Comm& comm, Command& c) {
   multigrid_options_from(a, c.opt.mg);
   friction_from(a, table, c.opt.friction);
   c.opt.nested = !a.has("--no-nested") && !table;  // --table: the paper's cold start
+  if (a.has("--coulomb-method") && !c.opt.friction.is_coulomb())
+    c.no_effect.push_back("--coulomb-method chooses how Coulomb friction is solved; this run is Tresca (--coulomb F)");
+  if (a.has("--no-nested") && table) c.no_effect.push_back("--no-nested: --table never nests (the paper's cold start)");
   c.quiet = a.has("--quiet");
   c.profile = a.has("--profile");
   c.json_path = a.str("--json");
@@ -276,6 +280,7 @@ void parse_command(const Args& a, const Comm& comm, Command& c) {
 
 // inputs that run but may not give what the user expects
 void warn_about(const Command& c) {
+  for (const std::string& w : c.no_effect) std::fprintf(stderr, "tresca: warning: no effect: %s\n", w.c_str());
   if (c.opt.newton.scaling == StepScaling::paper && (c.spec.E < 1e6 || c.spec.E > 1e12))
     std::fprintf(stderr,
                  "tresca: warning: --scaling paper adds forces [N] and displacements [m] as numbers, which suits the\n"

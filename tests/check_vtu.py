@@ -108,10 +108,11 @@ def check_fields(run, body, face):
     E, nu = run["problem"]["material"]["E"], run["problem"]["material"]["nu"]
     s = centre_stress(body, E, nu)
     scale = max(np.abs(s).max(), 1e-300)
-    if body["stress"].shape != s.shape or np.abs(body["stress"] - s).max() > 1e-9 * scale:
+    # (written in single precision: to float rounding of the largest)
+    if body["stress"].shape != s.shape or np.abs(body["stress"] - s).max() > 1e-6 * scale:
         fail("cell stress differs from the recomputed one by %.3e of its largest" %
              (np.abs(body["stress"] - s).max() / scale))
-    if np.abs(body["von_mises"] - von_mises(s)).max() > 1e-9 * scale:
+    if np.abs(body["von_mises"] - von_mises(s)).max() > 1e-6 * scale:
         fail("von_mises differs from the recomputed one")
     ex, ey, _ = run["dims"]
     area = nodal_area(face["points"], ex, ey)

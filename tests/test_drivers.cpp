@@ -112,6 +112,7 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --dims 4x2x2 --vtk o.vtu --vtk-format xml", "--vtk-format 'xml' must be binary or ascii");
   expect_error("tresca --dims 4x2x2 --vtk-every-iteration", "needs --vtk");
   expect_error("tresca --table 1-2 --vtk-every-iteration --vtk o.vtu", "needs --vtk");
+  expect_error("tresca --dims 4x2x2 --vtk-format ascii", "needs --vtk FILE.vtu");
   // messages say the value as given, and not 100 KB of it
   expect_error("tresca --dims 4x2x2 --nu 0.5", "nu = 0.5 ");
   expect_error("tresca --dims 4x2x2 --nu 0.50000001", "0.50000001");
@@ -124,6 +125,15 @@ TEST(TrescaDriver, RejectsBadOptions) {
   expect_error("tresca --dims 4x2x2 --json " + d + "/x --contact-csv " + d + "/x", "name the same file");
   expect_error("tresca --dims 4x2x2 --json " + d + "/B_contact.vtu --vtk " + d + "/B.vtu", "name the same file");
   expect_error("tresca --dims 4x2x2 --json " + d + "/a.json --contact-csv " + d + "/./a.json", "name the same file");
+}
+
+// options that would change nothing are said to, and the run goes on
+TEST(TrescaDriver, WarnsAboutOptionsWithoutEffect) {
+  expect_run("tresca --dims 4x2x2 --quiet --coulomb-method lagged", 0, "warning: no effect: --coulomb-method");
+  expect_run("tresca --table 1-1 --no-nested", 0, "warning: no effect: --no-nested");
+  const CmdResult quiet = run("tresca --dims 4x2x2 --quiet --coulomb 0.3 --coulomb-method lagged");
+  EXPECT_EQ(quiet.status, 0) << quiet.out;
+  EXPECT_EQ(quiet.out.find("warning"), std::string::npos) << quiet.out;
 }
 
 TEST(TrescaDriver, RunsTheExampleProblemFile) {

@@ -29,7 +29,7 @@ namespace {
 
 // One DataArray: its values as little-endian bytes of `type`.
 struct Array {
-  enum class Type { f64, i32, i64, u8 } type;
+  enum class Type { f64, f32, i32, i64, u8 } type;
   std::string name;  // empty: the Points array
   int components;
   std::vector<unsigned char> bytes;
@@ -42,12 +42,15 @@ struct Array {
   const char* type_name() const {
     switch (type) {
       case Type::f64: return "Float64";
+      case Type::f32: return "Float32";
       case Type::i32: return "Int32";
       case Type::i64: return "Int64";
       default: return "UInt8";
     }
   }
-  size_t size() const { return bytes.size() / (type == Type::f64 || type == Type::i64 ? 8 : type == Type::i32 ? 4 : 1); }
+  size_t size() const {
+    return bytes.size() / (type == Type::f64 || type == Type::i64 ? 8 : type == Type::i32 || type == Type::f32 ? 4 : 1);
+  }
   void write_ascii(std::FILE* f) const {
     const size_t n = size();
     for (size_t i = 0; i < n; ++i) {
@@ -57,6 +60,12 @@ struct Array {
           double x;
           std::memcpy(&x, &bytes[8 * i], 8);
           std::fprintf(f, "%.12g%c", x, sep);
+          break;
+        }
+        case Type::f32: {  // 9 digits: the float exactly
+          float x;
+          std::memcpy(&x, &bytes[4 * i], 4);
+          std::fprintf(f, "%.9g%c", double(x), sep);
           break;
         }
         case Type::i32: {
@@ -114,7 +123,7 @@ const char* kLegend =
     "     contact_pressure [Pa], lambda over the node's share of the contact face's area;\n"
     "     contact_status: 0 not a contact node (the clamped edge x = x0 or off the face), 1 separated,\n"
     "     2 stick, 3 slip. Cell data (body): stress [Pa], the Cauchy stress at the cell's centre (xx, yy,\n"
-    "     zz, xy, yz, xz); von_mises [Pa]. See docs/outputs.md. -->\n";
+    "     zz, xy, yz, xz; single precision); von_mises [Pa]. See docs/outputs.md. -->\n";
 
 // One piece of an unstructured grid: points, cells of one VTK type, point data.
 struct Piece {
@@ -238,7 +247,9 @@ void write_body(OutputSet& out, const std::string& path, const Problem& P, index
   const index n_cells = g.ex * (rows - 1) * g.ez;
   std::vector<index> conn;
   conn.reserve(size_t(8 * n_cells));
-  std::vector<double> stress(6 * size_t(n_cells)), mises(static_cast<size_t>(n_cells));
+  // derived fields in single precision: 7 digits are more than a stress
+  // plot resolves, and noisy doubles are the slowest data to compress
+  std::vector<float> stress(6 * size_t(n_cells)), mises(static_cast<size_t>(n_cells));
   const int order[8] = {0, 1, 3, 2, 4, 5, 7, 6};  // VTK_HEXAHEDRON node order
   index cell = 0;
   for (index ez = 0; ez < g.ez; ++ez)
@@ -250,16 +261,18 @@ void write_body(OutputSet& out, const std::string& path, const Problem& P, index
           const index m = ub.node(ex + (L & 1), ey + ((L >> 1) & 1) - rb, ez + ((L >> 2) & 1));
           for (int a = 0; a < 3; ++a) ue[3 * L + a] = u[a * Nu + m];
         }
-        centroid_stress(g.hx(), g.hy(), g.hz(), P.spec.E, P.spec.nu, ue, &stress[6 * cell]);
-        mises[cell] = von_mises(&stress[6 * cell]);
+        real s[6];
+        centroid_stress(g.hx(), g.hy(), g.hz(), P.spec.E, P.spec.nu, ue, s);
+        for (int k = 0; k < 6; ++k) stress[6 * cell + k] = float(s[k]);
+        mises[cell] = float(von_mises(s));
       }
   Piece body(xyz, conn, 8, 12);
   body.point_data.emplace_back(Array::Type::f64, "displacement", 3, disp);
   body.point_data.emplace_back(Array::Type::f64, "contact_force", 3, force);
   body.point_data.emplace_back(Array::Type::f64, "contact_pressure", 1, pressure);
   body.point_data.emplace_back(Array::Type::u8, "contact_status", 1, code);
-  body.cell_data.emplace_back(Array::Type::f64, "stress", 6, stress);
-  body.cell_data.emplace_back(Array::Type::f64, "von_mises", 1, mises);
+  body.cell_data.emplace_back(Array::Type::f32, "stress", 6, stress);
+  body.cell_data.emplace_back(Array::Type::f32, "von_mises", 1, mises);
   body.write(out.create(path), format);
 }
 
@@ -324,8 +337,8 @@ std::string write_pvtu(OutputSet& out, const std::string& path, const Problem& P
       "<PDataArray type=\"Float64\" Name=\"contact_pressure\" NumberOfComponents=\"1\"/>\n"
       "<PDataArray type=\"UInt8\" Name=\"contact_status\" NumberOfComponents=\"1\"/>\n</PPointData>\n"
       "<PCellData Tensors=\"stress\" Scalars=\"von_mises\">\n"
-      "<PDataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\"/>\n"
-      "<PDataArray type=\"Float64\" Name=\"von_mises\" NumberOfComponents=\"1\"/>\n</PCellData>\n"
+      "<PDataArray type=\"Float32\" Name=\"stress\" NumberOfComponents=\"6\"/>\n"
+      "<PDataArray type=\"Float32\" Name=\"von_mises\" NumberOfComponents=\"1\"/>\n</PCellData>\n"
       "<PPoints>\n<PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n</PPoints>\n";
   for (int q = 0; q < s.ranks; ++q) {
     std::string f = pvtu_piece_name(path, q);
