@@ -119,6 +119,7 @@ static const char* kHelp =
     "Threads: OMP_NUM_THREADS (default all cores).\n";
 
 int main(int argc, char** argv) {
+  static char benchmark_help[] = "--help";  // Google Benchmark's own --help
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "-h") || !std::strcmp(argv[i], "--help")) {
       std::fputs(kHelp, stdout);
@@ -128,7 +129,7 @@ int main(int argc, char** argv) {
       std::fputs(tresca::version_text("bench_kernels").c_str(), stdout);
       return 0;
     }
-    if (!std::strcmp(argv[i], "--help-benchmark")) argv[i] = const_cast<char*>("--help");
+    if (!std::strcmp(argv[i], "--help-benchmark")) argv[i] = benchmark_help;
   }
   benchmark::AddCustomContext("tresca kernels", tresca::build_info());
   benchmark::Initialize(&argc, argv);

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "core/contact/nested.hpp"
 #include "kernels/contact_maps.hpp"
 #include "kernels/element.hpp"
 
@@ -201,13 +202,6 @@ int status_code(std::uint8_t s) { return 1 + int(contact_state(s)); }
 
 namespace {
 
-// the area of the contact face that contact node (ix, iy) stands for: a
-// quarter of each face quad it is a corner of [m^2]
-double nodal_area(const GridDims& g, index ix, index iy) {
-  const double wx = (ix == 0 || ix == g.ex) ? 0.5 : 1, wy = (iy == 0 || iy == g.ey) ? 0.5 : 1;
-  return wx * wy * g.hx() * g.hy();
-}
-
 // the per-node contact id of the bottom plane (-1: not a contact node)
 std::vector<index> contact_ids(const Problem& P) {
   const GridDims& g = P.grid;
@@ -240,7 +234,7 @@ void write_body(OutputSet& out, const std::string& path, const Problem& P, index
             force[3 * n] = (*c.r)[i];
             force[3 * n + 1] = (*c.r)[p + i];
             force[3 * n + 2] = (*c.lambda)[i];
-            pressure[n] = (*c.lambda)[i] / nodal_area(g, ix, iy);
+            pressure[n] = (*c.lambda)[i] / contact_area(g, i);
             code[n] = std::uint8_t(status_code((*c.status)[i]));
           }
       }
@@ -293,7 +287,7 @@ void write_face(OutputSet& out, const std::string& path, const Problem& P, const
       force[3 * n] = (*c.r)[i];
       force[3 * n + 1] = (*c.r)[p + i];
       force[3 * n + 2] = (*c.lambda)[i];
-      pressure[n] = (*c.lambda)[i] / nodal_area(g, n % g.nx(), n / g.nx());
+      pressure[n] = (*c.lambda)[i] / contact_area(g, i);
       code[n] = std::uint8_t(status_code((*c.status)[i]));
     }
   }
