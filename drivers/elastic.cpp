@@ -29,7 +29,6 @@ static const char* kHelp =
     "Exit status: 0 converged, 1 not converged, 2 bad input.\n";
 
 int main(int argc, char** argv) {
-  default_runtime_environment(argv);
   MpiSession mpi(argc, argv);
   const Comm& comm = Comm::world();
   try {
@@ -39,6 +38,7 @@ int main(int argc, char** argv) {
     const ProblemSpec spec = spec_from_args(a, 6);
     const real rtol = a.real_value("--rtol", 1e-10);
     if (!(rtol > 0 && rtol < 1)) throw std::invalid_argument("--rtol " + a.str("--rtol") + " must lie in (0,1)");
+    warn_if_cores_busy();
     const double t0 = wall_time();
     const Problem P = make_problem(spec);  // every rank builds the whole load
     const Multigrid mg(P.grid, P.interior_faces, spec.E, spec.nu, MGOptions{}, comm);

@@ -106,7 +106,7 @@ namespace {
 // or on a mesh split over the ranks a .pvtu with one piece per rank (a mesh
 // too small to split is whole on every rank: rank 0 writes it).
 PvdStep write_step(OutputSet& out, double time, const std::string& vtu, const Problem& P, const Slab& rows,
-                   const std::vector<real>& u_full, const ContactFields& cf, VtkFormat format) {
+                   const Field<real>& u_full, const ContactFields& cf, VtkFormat format) {
   if (rows.ranks > 1) return {time, {path_stem(vtu) + ".pvtu", write_pvtu(out, vtu, P, rows, u_full, cf, format)}};
   if (Comm::world().rank() != 0) return {time, {vtu, vtu_companion(vtu)}};
   return {time, {vtu, write_vtu(out, vtu, P, u_full, cf, format)}};
@@ -383,7 +383,7 @@ void print_header(const Command& c, const ThreadPlacement& placement, const Comm
   std::printf("        estimated peak memory %.2f GB%s; kernels: %s; %s\n",
               estimated_memory_bytes_per_rank(spec, comm.size()) / 1e9, comm.distributed() ? " per rank" : "",
               build_info().c_str(), omp_wait_setting().c_str());
-  std::printf("        %s\n", placement.describe().c_str());
+  std::printf("        %s; %s\n", placement.describe().c_str(), huge_page_setting().c_str());
 }
 
 // how the friction law's iteration ended (Coulomb)
@@ -509,6 +509,7 @@ void write_outputs(const Command& c, const RunResult& R, OutputSet& out, const s
 int run(Command& c, const Comm& comm) {
   if (comm.rank() != 0) c.json_path = c.csv_path = "";  // outputs: rank 0's (and a piece of the VTU each)
   warn_about(c);
+  warn_if_cores_busy();
   if (!c.quiet) show_progress(c.opt);
   if (!c.table.empty()) return run_table(c, comm);
   const ThreadPlacement placement = thread_placement();
@@ -530,7 +531,6 @@ int run(Command& c, const Comm& comm) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  default_runtime_environment(argv);
   // Under mpirun with several ranks every rank runs this main: the 3D work is
   // split into y-slabs (steklov.hpp), the contact iteration is the same on
   // every rank, and rank 0 alone prints and writes the outputs.

@@ -130,8 +130,8 @@ ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, re
   const index N = g.nodes();
   k.slot.assign(32 * 32 * 32, -1);
   k.first.push_back(0);
-  auto distinct = [](const std::vector<std::uint8_t>& v) {
-    std::vector<std::uint8_t> u(v);
+  auto distinct = [](const Field<std::uint8_t>& v) {
+    std::vector<std::uint8_t> u(v.begin(), v.end());
     std::sort(u.begin(), u.end());
     u.erase(std::unique(u.begin(), u.end()), u.end());
     return u;

@@ -24,12 +24,58 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 namespace tresca {
 
+// Host storage of a Field: large arrays (>= 4 MiB) are aligned to 2 MiB and
+// marked MADV_HUGEPAGE, so where the kernel's transparent-huge-page mode is
+// "madvise" (Debian's default) their first touch costs one page fault per
+// 2 MiB instead of per 4 KiB (perf/RESULTS.md §0d, §0k). Smaller arrays come
+// from operator new as usual.
+void* field_allocate(std::size_t bytes);
+void field_deallocate(void* p, std::size_t bytes) noexcept;
+
 template <class T>
-using Field = std::vector<T>;
+struct FieldAllocator {
+  using value_type = T;
+  FieldAllocator() = default;
+  template <class U>
+  FieldAllocator(const FieldAllocator<U>&) noexcept {}
+  T* allocate(std::size_t n) { return static_cast<T*>(field_allocate(n * sizeof(T))); }
+  void deallocate(T* p, std::size_t n) noexcept { field_deallocate(p, n * sizeof(T)); }
+  template <class U>
+  bool operator==(const FieldAllocator<U>&) const noexcept { return true; }
+  template <class U>
+  bool operator!=(const FieldAllocator<U>&) const noexcept { return false; }
+};
+
+template <class T>
+using Field = std::vector<T, FieldAllocator<T>>;
+
+// The device backend (a build with TRESCA_OFFLOAD, CMake option of that
+// name: g++-12 with gcc-12-offload-nvptx). While launch_on_device() is
+// true, for_each_entry and sum_over_blocks run their bodies as OpenMP
+// target regions (`target teams distribute parallel for simd`) on the
+// default device, over pointers that must then be device pointers
+// (device_allocate); without a GPU the target regions run on the host.
+// Only these two launchers have a device branch so far: the vector
+// operations. The stencil applies, transfers and smoothers, and Field
+// storage on the device, are issue 22's next steps. Without
+// TRESCA_OFFLOAD, launch_on_device() is false and set_launch_on_device
+// refuses true.
+bool launch_on_device();
+void set_launch_on_device(bool on);  // throws std::invalid_argument if the build has no offload
+bool offload_built();                // whether this build has TRESCA_OFFLOAD
+// device memory of the default device (omp_target_alloc; the host's when
+// there is none), and copies to and from it
+void* device_allocate(std::size_t bytes);
+void device_free(void* p) noexcept;
+void copy_to_device(void* device, const void* host, std::size_t bytes);
+void copy_from_device(void* host, const void* device, std::size_t bytes);
+// "NVIDIA ... (device 0 of 1)" or "none: target regions run on the host"
+std::string device_description();
 
 // How many workers a launch has (threads on the host): a kernel that cuts
 // its range into cache-sized blocks makes at least one block per worker.
@@ -38,6 +84,14 @@ inline index launch_width() { return omp_get_max_threads(); }
 // body(i) for every i in [0, n), independent entries vectorised across i.
 template <class Body>
 inline void for_each_entry(index n, Cost per_entry, const Body& body) {
+#ifdef TRESCA_OFFLOAD
+  if (launch_on_device()) {
+    const Body b = body;  // the body's captures (device pointers, scalars) travel by value
+#pragma omp target teams distribute parallel for simd map(to : b)
+    for (index i = 0; i < n; ++i) b(i);
+    return;
+  }
+#endif
 #pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * per_entry))
   for (index i = 0; i < n; ++i) body(i);
 }
@@ -88,6 +142,13 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
     heap.resize(nb);
     part = heap.data();
   }
+#ifdef TRESCA_OFFLOAD
+  if (launch_on_device()) {
+    const Block bl = block;
+#pragma omp target teams distribute parallel for map(to : bl) map(from : part[0:nb])
+    for (index b = 0; b < nb; ++b) part[b] = bl(b * width, b + 1 < nb ? (b + 1) * width : n);
+  } else
+#endif
 #pragma omp parallel for schedule(static) if (worth_threads(double(n) * per_entry))
   for (index b = 0; b < nb; ++b) part[b] = block(b * width, std::min(n, (b + 1) * width));
   real s = 0;

@@ -24,7 +24,6 @@ static const char* kHelp =
     "  -h, --help         this text;  --version  the version and the build (ISA, compiler)\n";
 
 int main(int argc, char** argv) {
-  default_runtime_environment(argv);
   require_one_rank("mg_scaling");
   try {
     Args a(argc, argv, {"--levels", "--rtol", "--threads", "--json", "--precision"}, {});
@@ -41,6 +40,7 @@ int main(int argc, char** argv) {
     const std::string json = a.str("--json");
     if (!json.empty()) check_writable(json);
     for (int L : levels) check_memory(spec_for_level(L));
+    warn_if_cores_busy();
     std::printf("# kernels: %s, %d threads\n", build_info().c_str(), threads);
     std::printf("%5s %11s %-70s %6s %9s %9s %11s %s\n", "level", "dofs", "hierarchy", "iters", "setup[s]", "solve[s]",
                 "s/iter", "rel.res (recomputed)");

@@ -98,7 +98,6 @@ int project(const Args& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  default_runtime_environment(argv);
   MpiSession mpi(argc, argv);
   const Comm& comm = Comm::world();
   try {
@@ -113,6 +112,7 @@ int main(int argc, char** argv) {
     const real rtol = a.real_value("--rtol", 1e-6);
     const int max_it = int(a.int_value("--max-iterations", 20000));
     if (reps < 1) throw std::invalid_argument("--reps must be >= 1");
+    warn_if_cores_busy();
     const GridDims g = grid_of(spec);
     const Slab slab = make_slab(g, comm.rank(), comm.size());
     const Problem P = make_problem(spec);  // every rank builds the global load (phase 1)

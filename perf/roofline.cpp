@@ -112,7 +112,6 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  default_runtime_environment(argv);
   require_one_rank("roofline");
   try {
     Args a(argc, argv, {"--level", "--threads", "--reps", "--json"}, {});
@@ -126,6 +125,7 @@ int main(int argc, char** argv) {
     const std::string json = a.str("--json");
     if (!json.empty()) check_writable(json);
 
+    warn_if_cores_busy();
     const double stream = triad_bandwidth(tresca::index(1) << 25, int(std::min(reps, 10LL)));
     const double bw = stream * 32.0 / 24.0;  // with the write-allocate read of a
     const double peak = fma_peak<double>(20000000), peak_single = fma_peak<float>(20000000);

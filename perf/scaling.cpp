@@ -46,7 +46,6 @@ static const char* kHelp =
     "Exit status: 0 all converged, 1 some did not, 2 bad input.\n";
 
 int main(int argc, char** argv) {
-  default_runtime_environment(argv);
   require_one_rank("scaling");
   try {
     Args a(argc, argv, {"--levels", "--threads", "--repeat", "--phi", "--coulomb", "--coulomb-method", "--json"}, {"--no-nested"});
@@ -73,6 +72,7 @@ int main(int argc, char** argv) {
     const std::string json = a.str("--json");
     if (!json.empty()) check_writable(json);
     for (int L : levels) check_memory(spec_for_level(L));
+    warn_if_cores_busy();
     std::printf("# kernels: %s\n", build_info().c_str());
     std::printf("# fmv: fine-grid matvec equivalents (the solvers' work counts); fmv K_ii: one MG-CG solve of K_ii to 1e-10\n");
     std::printf("# nested iteration %s; newton, outer, inner, S-app, fmv/step: this mesh; fmv nest: the coarser meshes;\n"

@@ -180,7 +180,8 @@ TEST(BottomBlock, OptimisedEqualsReferenceAndAssembly) {
   const GridDims g = test::prism(4, 3, 2);
   ElasticityOperator A(g, kFaceX0, 1.0, 0.3);
   const index M = g.nx() * g.ny();
-  A.set_bottom_block(random_vector(4 * M, 21));
+  const std::vector<real> B = random_vector(4 * M, 21);
+  A.set_bottom_block(Field<real>(B.begin(), B.end()));
   auto x = random_vector(A.size(), 22);
   std::vector<real> y(A.size(), 0), yr(A.size(), 0);
   bottom_block_apply(g, 0.5, A.bottom_block().data(), x.data(), y.data());

@@ -34,13 +34,16 @@ inline std::vector<real> random_vector(index n, std::uint64_t seed = 1) {
   return v;
 }
 
-inline real max_abs(const std::vector<real>& v) {
+// for std::vector and Field alike
+template <class Vec>
+real max_abs(const Vec& v) {
   real m = 0;
   for (real x : v) m = std::max(m, std::abs(x));
   return m;
 }
 
-inline real max_abs_diff(const std::vector<real>& a, const std::vector<real>& b) {
+template <class VecA, class VecB>
+real max_abs_diff(const VecA& a, const VecB& b) {
   real m = 0;
   for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
   return m;

@@ -137,10 +137,10 @@ TEST(SlabCG, SameIterationsAndSolutionAsTheWholeGrid) {
   const ElasticityOperator Kg(g, kFaces, 2.1e9, 0.277);
   std::vector<real> bg = test::random_vector(3 * g.nodes(), 11);
   zero_constrained(g, kFaces, bg.data());
-  const std::vector<real> dg = Kg.diagonal();
+  const Field<real> dg = Kg.diagonal();
   struct Jacobi : LinearOperator {
-    const std::vector<real>& d;
-    explicit Jacobi(const std::vector<real>& d_) : d(d_) {}
+    const Field<real>& d;
+    explicit Jacobi(const Field<real>& d_) : d(d_) {}
     index size() const override { return index(d.size()); }
     void apply(const real* r, real* z) const override {
       for (size_t i = 0; i < d.size(); ++i) z[i] = r[i] / d[i];

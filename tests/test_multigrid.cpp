@@ -23,10 +23,10 @@ TEST(MultigridCG, MatchesSparseDirectSolveOnOddMeshes) {
     ASSERT_GE(mg.num_levels(), 2);
     const InteriorSolution sol = solve_interior_elasticity(P, mg, 1e-12);
     const SolveStats& st = sol.stats;
-    const std::vector<real>& u = sol.u;
+    const Field<real>& u = sol.u;
     ASSERT_TRUE(st.ok()) << to_string(st.reason);
     EXPECT_LT(sol.relative_residual, 1e-11);
-    std::vector<real> b(P.load);
+    std::vector<real> b(P.load.begin(), P.load.end());
     zero_constrained(P.grid, P.interior_faces, b.data());
     EXPECT_LT(st.iterations, 40);
     Eigen::SimplicialLDLT<SparseMatrix> ldlt(assemble(mg.op(0)));
@@ -48,7 +48,7 @@ TEST(MultigridCG, SinglePrecisionVCycleKeepsIterationsAndAccuracy) {
     for (bool odd : {false, true}) {
       const Problem P = odd ? make_problem(spec_for_dims(23, 11, 13)) : make_problem(spec_for_level(level));
       int its[2];
-      std::vector<real> u[2];
+      Field<real> u[2];
       for (int k = 0; k < 2; ++k) {
         MGOptions mo;
         mo.precision = k ? Precision::single_precision : Precision::double_precision;
@@ -156,7 +156,7 @@ TEST(MultigridCG, SemiCoarseningKeepsAnisotropicMeshesFast) {
 TEST(CG, ReportsMaxIterationsInsteadOfLooping) {
   const Problem P = make_problem(spec_for_level(4));
   ElasticityOperator A(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
-  std::vector<real> b(P.load), u(P.dofs());
+  std::vector<real> b(P.load.begin(), P.load.end()), u(P.dofs());
   zero_constrained(P.grid, P.interior_faces, b.data());
   CGOptions o;
   o.rtol = 1e-14;

@@ -63,7 +63,8 @@ TEST(SteklovPoincare, RecoveryAndResidualMatchDense) {
   for (auto& v : uc) v *= 1e-3;
   // u = E u_c + K_ii^{-1} l_i: the extension from an S apply, the interior
   // load solution from the condensed load
-  std::vector<real> u(3 * P.nodes()), li, b, Sv(S.size());
+  std::vector<real> u(3 * P.nodes()), b, Sv(S.size());
+  Field<real> li;
   ASSERT_TRUE(S.apply(uc.data(), Sv.data(), 1e-13, u.data()).ok());
   ASSERT_TRUE(S.condensed_load(1e-13, b, &li).ok());
   for (size_t i = 0; i < u.size(); ++i) u[i] += li[i];

@@ -48,7 +48,7 @@ class BoundaryPreconditioner : public LinearOperator {
   std::unique_ptr<Multigrid> mg_;  // K + B
   std::vector<real> kdiag_;  // diag of K at this rank's contact nodes (3 blocks)
   std::vector<std::uint8_t> free_;
-  mutable std::vector<real> full_in_, full_out_;
+  mutable Field<real> full_in_, full_out_;
 };
 
 }  // namespace tresca

@@ -9,7 +9,7 @@
 namespace tresca {
 
 FinalReport final_report(const SteklovPoincare& S, const ContactConditions& law, const NewtonResult& R,
-                         real tight_rtol, std::vector<real>* body, real tolerance) {
+                         real tight_rtol, Field<real>* body, real tolerance) {
   const index p = S.size() / 3;
   const std::vector<real>& phi = law.phi;
   FinalReport F;

@@ -51,6 +51,6 @@ struct FinalReport {
 // in the metric of R's steps (NewtonResult::scale). tolerance [N]: the
 // verdict's (0: R.tolerance).
 FinalReport final_report(const SteklovPoincare& S, const ContactConditions& law, const NewtonResult& R,
-                         real tight_rtol = 1e-12, std::vector<real>* body = nullptr, real tolerance = 0);
+                         real tight_rtol = 1e-12, Field<real>* body = nullptr, real tolerance = 0);
 
 }  // namespace tresca

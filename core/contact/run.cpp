@@ -33,12 +33,13 @@ namespace {
 // of K_ii^{-1} l_i; NewtonOptions points into it
 struct Start {
   std::vector<real> u0, lambda0;  // the coarser mesh's (empty: none)
-  std::vector<real> load_guess;   // K_ii^{-1} l_i, interpolated
-  std::vector<real> body;         // the guess at u0, then U = E u + K_ii^{-1} l_i
+  Field<real> load_guess;         // K_ii^{-1} l_i, interpolated
+  Field<real> body;               // the guess at u0, then U = E u + K_ii^{-1} l_i
   const std::vector<real>* given_u0 = nullptr;  // a restart's or continuation's
   const std::vector<real>* given_lambda0 = nullptr;
   std::vector<real> local[4];  // this rank's part of u0, lambda0, given u0, given lambda0
-  std::vector<real> given_body, r0, r_given;
+  Field<real> given_body;
+  std::vector<real> r0, r_given;
 };
 
 // Nested iteration: the coarser mesh first (before this mesh's operators
@@ -90,7 +91,8 @@ void show_iterates(const SteklovPoincare& S, const RunOptions& opt, RunResult& R
   newton.progress = [S = &S, R = &R, done = opt.iterate_done, rows, shown = newton.progress,
                      step = 0](const NewtonProgress& pr) mutable {
     if (shown) shown(pr);
-    std::vector<real> r(pr.u->size()), u_full(S->full_size());
+    std::vector<real> r(pr.u->size());
+    Field<real> u_full(S->full_size());
     S->residual(pr.u->data(), r.data(), 1e-8, u_full.data());
     S->exchange_ghosts(u_full.data());
     const std::vector<real> u = S->whole(*pr.u, 3), lambda = S->whole(*pr.lambda, 1), rw = S->whole(*pr.r, 3),
@@ -142,7 +144,7 @@ void choose_initial_iterate(const SteklovPoincare& S, const RunOptions& opt, con
   // (to 1e-2: the merits differ by factors; the winner's r, body and that
   // accuracy go to Newton, which refines r where it needs to)
   const real choice_rtol = 1e-2;
-  auto merit = [&](const std::vector<real>& u, const std::vector<real>& lambda, std::vector<real>& b,
+  auto merit = [&](const std::vector<real>& u, const std::vector<real>& lambda, Field<real>& b,
                    std::vector<real>& r, bool warm) {
     const index p = S.contact_nodes();
     std::vector<real> v(4 * p), w(4 * p), d(3 * p);
@@ -284,7 +286,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
 
   // the final check's tight residual, warm from Newton's body (or, if
   // Newton did not run, the guess at u0), also recovers the body
-  std::vector<real> body = std::move(start.body);
+  Field<real> body = std::move(start.body);
   if (!R.newton.body.empty()) body = std::move(R.newton.body);
   R.newton.body = {};
   R.report = final_report(S, law, R.newton, opt.tight_rtol, &body,

@@ -35,7 +35,7 @@ struct Iterate {
   const Problem* problem;
   int step;  // 0, 1, ... over the run (a Coulomb fixed point's Tresca solves continue it)
   const NewtonProgress* progress;
-  const std::vector<real>* u_full;  // 3N SoA: E u + K_ii^{-1} l_i (several ranks: on `slab`, ghost rows current)
+  const Field<real>* u_full;        // 3N SoA: E u + K_ii^{-1} l_i (several ranks: on `slab`, ghost rows current)
   const std::vector<real>* gap;     // p
   const Slab* slab;                 // the rank's rows of u_full (one rank: the whole grid)
 };
@@ -106,9 +106,9 @@ struct RunResult {
     return report.kkt_ok ? "converged" : "kkt_check_failed";
   }
   FinalReport report;
-  std::vector<real> u_full;         // 3N SoA (empty if not recovered); several ranks: slab's local vector
+  Field<real> u_full;               // 3N SoA (empty if not recovered); several ranks: slab's local vector
   Slab slab;                        // the rank's rows of u_full (one rank: the whole grid)
-  std::vector<real> interior_load;  // K_ii^{-1} l_i to scale_rtol, 3N SoA (keep_interior_load only)
+  Field<real> interior_load;        // K_ii^{-1} l_i to scale_rtol, 3N SoA (keep_interior_load only)
   long long inner_iterations = 0;  // over the whole run, including condensation and the final check
   // work in fine-grid matvec equivalents (the Newton phase alone is
   // newton.fine_matvecs): the whole run, |b̃|, Newton and the final tight

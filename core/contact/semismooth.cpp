@@ -185,7 +185,7 @@ struct StepOutcome {
 // whole step (known increments included; inexact; GMRES: the known part only).
 StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreconditioner* M, real eta, real floor,
                        real s_bound, bool any_known, InnerWork& work, CGWorkspace& ws, std::vector<real>& du,
-                       std::vector<real>& side, std::vector<real>& known_side) {
+                       Field<real>& side, Field<real>& known_side) {
   const index n3 = S.size(), nf = S.full_size();
   real* scratch = known_side.data();  // S Δu_known, then E Δu_known
   StepOutcome out;
@@ -385,7 +385,9 @@ class NewtonSolve {
   const real* units = nullptr;      // the diagonal metric of the residual in consistent units
   Point trial;
   // side: [S Δu | E Δu] of the step; known_side: the same of its known increments
-  std::vector<real> v, d, du, side, known_side, dlambda;
+  std::vector<real> v, d, du;
+  Field<real> side, known_side;
+  std::vector<real> dlambda;
   ReducedSystem L;
   std::unique_ptr<BoundaryPreconditioner> M;
   CGWorkspace ws;

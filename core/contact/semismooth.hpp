@@ -141,7 +141,7 @@ struct NewtonOptions {
   const std::vector<real>* lambda0 = nullptr;
   // optional: a guess of the body's displacement at u0 (S.full_size(),
   // steklov.hpp: residual), e.g. a coarser mesh's, interpolated
-  const std::vector<real>* body0 = nullptr;
+  const Field<real>* body0 = nullptr;
   // |b̃| [N], the scale of r's absolute accuracy; 0: |r| at x0 = 0 (= |b̃|).
   // Required with u0 (e.g. from a loose SteklovPoincare::condensed_load).
   real force_scale = 0;
@@ -169,7 +169,7 @@ struct NewtonResult {
   real tolerance = 0;                  // the stopping test's max(eps, rtol |·_0|)
   std::vector<long long> inner_history, outer_history;  // cumulative inner / outer CG iterations there
   std::vector<real> u, lambda, r;      // 3p, p, 3p: r = S u - b̃ (to residual_accuracy if converged)
-  std::vector<real> body;              // U = E u + K_ii^{-1} l_i (S.full_size()) of that r
+  Field<real> body;                    // U = E u + K_ii^{-1} l_i (S.full_size()) of that r
   real force_scale = 0;                // |b̃| used for the accuracies
   std::vector<std::uint8_t> status;    // per node: kContact | kStick at the last approximation step
   std::vector<real> phi;               // the Tresca bound of the last approximation step

@@ -85,7 +85,7 @@ std::vector<std::uint8_t> SteklovPoincare::whole(const std::vector<std::uint8_t>
 }
 
 std::vector<real> SteklovPoincare::contact_diagonal() const {
-  const std::vector<real> d = K_.diagonal();
+  const Field<real>& d = K_.diagonal();
   std::vector<real> dc(3 * p_);
   gather(d.data(), dc.data());
   return dc;
@@ -130,7 +130,8 @@ SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* exte
 SolveStats SteklovPoincare::residual(const real* u, real* r, real rtol, real* body, const real* guess) const {
   // the load on this rank's rows (all of it on one rank); its interior part
   // is the solve's right-hand side besides -K_ic u
-  std::vector<real> load(full_size());
+  Field<real>& load = load_;
+  load.resize(full_size());
   global_to_local(slab(), P_.load.data(), load.data());
   std::vector<real> lc(3 * p_);
   gather(load.data(), lc.data());
@@ -169,7 +170,7 @@ double SteklovPoincare::apply_work(long long inner_iterations) const {
   return double(inner_iterations) * (1 + mg_->cycle_work()) + 2.0 / double(P_.grid.nz());
 }
 
-SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior,
+SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b, Field<real>* interior,
                                            const real* guess) const {
   // b̃ = -(S 0 - b̃)
   const std::vector<real> zero(3 * p_, 0.0);

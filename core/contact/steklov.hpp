@@ -88,7 +88,7 @@ class SteklovPoincare {
   // for contact values u_c is then E u_c + K_ii^{-1} l_i: recovery costs no
   // solve beyond the final check's S u_c.
   // guess (3N): initial guess of K_ii^{-1} l_i.
-  SolveStats condensed_load(real rtol, std::vector<real>& b, std::vector<real>* interior = nullptr,
+  SolveStats condensed_load(real rtol, std::vector<real>& b, Field<real>* interior = nullptr,
                             const real* guess = nullptr) const;
 
   // the K_ii multigrid; its hierarchy() is shared with the Newton step's preconditioner
@@ -125,7 +125,7 @@ class SteklovPoincare {
   index c_begin_ = 0, c_end_ = 0;  // this rank's contact nodes
   std::vector<int> counts_, displs_;           // every rank's contact nodes (whole())
   mutable CGWorkspace ws_;  // scratch
-  mutable std::vector<real> w_, t_, z_;
+  mutable Field<real> w_, t_, z_, load_;  // load_: residual()'s l on this rank's rows
 };
 
 }  // namespace tresca

@@ -31,7 +31,7 @@ const ElasticityStencilT<float>& ElasticityOperator::stencil_in<float>() const {
   return kf_;
 }
 template <>
-const std::vector<double>& ElasticityOperator::block_in<double>() const {
+const Field<double>& ElasticityOperator::block_in<double>() const {
   return B_;
 }
 template <>
@@ -64,7 +64,7 @@ void ElasticityOperator::apply_planes(const real* x, real* y, index z_begin, ind
   apply_rows<real>(x, y, nullptr, z_begin, z_end);
 }
 
-void ElasticityOperator::set_bottom_block(const std::vector<real>& B) {
+void ElasticityOperator::set_bottom_block(const Field<real>& B) {
   const GridDims& G = slab_.global;
   const index M = G.nx() * G.ny();
   if (!B.empty() && index(B.size()) != 4 * M)
@@ -73,7 +73,7 @@ void ElasticityOperator::set_bottom_block(const std::vector<real>& B) {
   B_.clear();
   Bf_.clear();
   if (B.empty()) return;
-  std::vector<real> Bz = B;
+  Field<real> Bz = B;
   zero_constrained_bottom_block(G, global_faces_, Bz);
   const GridDims& g = slab_.local;
   const index Ml = g.nx() * g.ny(), row0 = slab_.y_begin - slab_.lo;
@@ -84,7 +84,7 @@ void ElasticityOperator::set_bottom_block(const std::vector<real>& B) {
   Bf_.assign(B_.begin(), B_.end());
 }
 
-void zero_constrained_bottom_block(const GridDims& g, unsigned faces, std::vector<real>& B) {
+void zero_constrained_bottom_block(const GridDims& g, unsigned faces, Field<real>& B) {
   if (B.empty()) return;
   const index M = g.nx() * g.ny();
   for (index iy = 0; iy < g.ny(); ++iy)

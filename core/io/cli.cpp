@@ -245,16 +245,6 @@ bool cores_free_at_start() {
 }  // namespace
 
 namespace {
-bool user_placed_threads() {
-  for (const char* v : {"OMP_PROC_BIND", "OMP_PLACES", "GOMP_CPU_AFFINITY"})
-    if (std::getenv(v)) return true;
-  // valgrind runs the program inside its tool (whose /proc/self/exe a
-  // re-exec would start) and preloads its core library into it
-  const char* preload = std::getenv("LD_PRELOAD");
-  return preload && std::string(preload).find("vgpreload") != std::string::npos;
-}
-bool defaults_applied = false;
-
 // "0-3,8" from a CPU set
 std::string cpu_list(const cpu_set_t& set) {
   std::string out;
@@ -287,7 +277,6 @@ ThreadPlacement thread_placement() {
   t.cpus = CPU_COUNT(&all);
   if (const char* b = std::getenv("OMP_PROC_BIND")) t.proc_bind = b;
   if (const char* p = std::getenv("OMP_PLACES")) t.places = p;
-  t.defaults_applied = defaults_applied;
   return t;
 }
 
@@ -297,36 +286,29 @@ std::string ThreadPlacement::describe() const {
   for (size_t i = 0; i < thread_cpus.size(); ++i) os << (i ? " " : " ") << i << ":{" << thread_cpus[i] << "}";
   if (!proc_bind.empty()) os << ", OMP_PROC_BIND=" << proc_bind;
   if (!places.empty()) os << ", OMP_PLACES=" << places;
-  if (!defaults_applied) os << "; runtime defaults not applied (environment as given)";
   return os.str();
 }
 
-void default_runtime_environment(char** argv) {
-  // a re-executed child (or a user who set all three) finds them set
-  defaults_applied = std::getenv("GLIBC_TUNABLES") && std::getenv("OMP_WAIT_POLICY");
-  if (user_placed_threads()) return;
-  bool changed = false;
-  auto set_default = [&](const char* name, const char* value) {
-    if (!std::getenv(name)) {
-      setenv(name, value, 0);
-      changed = true;
-    }
-  };
-  // idle threads wait for the next parallel region by spinning a little
-  // (10,000 spins, a few microseconds) before they sleep, but only where
-  // the cores were free at start: a spinning thread takes its core from
-  // whoever else runs there
-  if (!std::getenv("OMP_WAIT_POLICY") && !std::getenv("GOMP_SPINCOUNT"))
-    set_default("GOMP_SPINCOUNT", cores_free_at_start() ? "10000" : "0");
-  set_default("OMP_WAIT_POLICY", "passive");
-  set_default("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1");
-  if (changed) execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
+void warn_if_cores_busy() {
+  if (std::getenv("OMP_WAIT_POLICY") || std::getenv("GOMP_SPINCOUNT") || launched_ranks() > 1) return;
+  if (omp_get_max_threads() < 2 || cores_free_at_start()) return;
+  std::fprintf(stderr,
+               "warning: another process is running on this machine's cores; idle OpenMP threads spin "
+               "before they sleep (libgomp's default) and take its time: OMP_WAIT_POLICY=passive makes them "
+               "sleep at once (docs/usage.md, Threads)\n");
+}
+
+std::string huge_page_setting() {
+  const char* t = std::getenv("GLIBC_TUNABLES");
+  if (t && std::string(t).find("glibc.malloc.hugetlb=1") != std::string::npos)
+    return "huge pages: every allocation (GLIBC_TUNABLES=glibc.malloc.hugetlb=1)";
+  return "huge pages: arrays of 1 MiB and more";
 }
 
 std::string omp_wait_setting() {
   const char* policy = std::getenv("OMP_WAIT_POLICY");
   const char* spins = std::getenv("GOMP_SPINCOUNT");
-  return std::string("OMP_WAIT_POLICY=") + (policy ? policy : "(unset)") +
+  return std::string("OMP_WAIT_POLICY=") + (policy ? policy : "(unset: libgomp's default, spin then sleep)") +
          (spins ? std::string(", GOMP_SPINCOUNT=") + spins : std::string());
 }
 

@@ -44,40 +44,34 @@ Obstacle parse_obstacle(const std::string& text);
 std::vector<int> parse_level_range(const std::string& s);
 // throws if the estimated memory of a run exceeds the machine's physical memory
 void check_memory(const ProblemSpec& s);
-// The drivers' runtime defaults, read by libgomp and glibc only when the
-// process starts, so if a variable is unset this re-executes the program once
-// with it set; a user's own setting is always kept. Call it first in main.
-// - OMP_WAIT_POLICY=passive with GOMP_SPINCOUNT=10000 where the cores were
-//   free at start (else 0): idle threads spin a few microseconds, then
-//   sleep. Faster on an idle machine; with another process on a core,
-//   spinning threads take its time, so a run that finds a core busy at
-//   start sleeps at once (perf/RESULTS.md §0d). Unless the user set either.
-// - GLIBC_TUNABLES=glibc.malloc.hugetlb=1: malloc asks for transparent huge
-//   pages (where the kernel's THP mode is "madvise", as on Debian): first
-//   touch of the large arrays costs 512x fewer page faults (the setup and
-//   the run it saves: perf/RESULTS.md §0d).
-// The drivers set these by re-executing themselves (the runtime reads them
-// before main), except where the user placed the threads (OMP_PROC_BIND,
-// OMP_PLACES, GOMP_CPU_AFFINITY) or the program runs under valgrind: libgomp
-// binds the initial thread at start-up, and a re-executed process would
-// inherit that one-CPU mask for all its threads (issue 21). Those runs keep
-// the environment as given; thread_placement() says where threads run.
-void default_runtime_environment(char** argv);
+// The drivers run in the environment they are given: they set no runtime
+// variable and never re-execute themselves, so a user's OpenMP and MPI
+// placement (OMP_PROC_BIND, OMP_PLACES, mpirun's binding) and tools such as
+// valgrind see the program as started. Large arrays get transparent huge
+// pages from their own allocator (Field, kernels/launch.hpp), not from
+// GLIBC_TUNABLES. How idle threads wait is libgomp's to decide from
+// OMP_WAIT_POLICY / GOMP_SPINCOUNT, read before main; warn_if_cores_busy
+// says when the libgomp default (spin, then sleep) would take the time of
+// another process running on this machine's cores (docs/usage.md).
+// The drivers call it once their options are read, before the work.
+void warn_if_cores_busy();
 // Where this process's OpenMP threads may run: each thread's allowed CPUs
 // (sched_getaffinity, as a list like "0-3,8"), how many distinct CPUs they
-// cover, the user's OMP_PROC_BIND / OMP_PLACES (empty if unset), and
-// whether the runtime defaults above were applied.
+// cover and the user's OMP_PROC_BIND / OMP_PLACES (empty if unset).
 struct ThreadPlacement {
   std::vector<std::string> thread_cpus;
   int cpus = 0;
   std::string proc_bind, places;
-  bool defaults_applied = false;
   std::string describe() const;  // one line for the run's header
 };
 ThreadPlacement thread_placement();
 // how idle OpenMP threads wait in this process: "OMP_WAIT_POLICY=...,
 // GOMP_SPINCOUNT=..." as the runtime read them (printed and in the JSON)
 std::string omp_wait_setting();
+// which allocations get transparent huge pages in this process: the large
+// arrays (Field) always; every malloc where GLIBC_TUNABLES has
+// glibc.malloc.hugetlb=1 (the launcher line of docs/usage.md)
+std::string huge_page_setting();
 // Exits with status 2 and a message (from the first rank) when mpirun
 // started this program as several ranks: for the drivers that are not
 // distributed (scaling, mg_scaling, roofline), whose N copies would each

@@ -73,13 +73,13 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   }
   j["build"] = build_info();
   j["omp_wait"] = omp_wait_setting();
+  j["huge_pages"] = huge_page_setting();
   {
     const ThreadPlacement t = thread_placement();
     j["placement"] = {{"thread_cpus", t.thread_cpus},
                       {"cpus", t.cpus},
                       {"omp_proc_bind", t.proc_bind.empty() ? Json(nullptr) : Json(t.proc_bind)},
-                      {"omp_places", t.places.empty() ? Json(nullptr) : Json(t.places)},
-                      {"runtime_defaults_applied", t.defaults_applied}};
+                      {"omp_places", t.places.empty() ? Json(nullptr) : Json(t.places)}};
   }
   j["mg_precision"] = to_string(opt.mg.precision);
   j["newton_iterations"] = N.iterations;

@@ -305,7 +305,7 @@ void write_face(OutputSet& out, const std::string& path, const Problem& P, const
 
 }  // namespace
 
-std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
+std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const Field<real>& u_full,
                       const ContactFields& c, VtkFormat format) {
   write_body(out, path, P, 0, P.grid.ny(), u_full.data(), P.grid, 0, c, format);
   const std::string cpath = vtu_companion(path);
@@ -318,7 +318,7 @@ std::string pvtu_piece_name(const std::string& path, int rank) {
 }
 
 std::string write_pvtu(OutputSet& out, const std::string& path, const Problem& P, const Slab& s,
-                       const std::vector<real>& u_local, const ContactFields& c, VtkFormat format) {
+                       const Field<real>& u_local, const ContactFields& c, VtkFormat format) {
   // this rank's rows and the ghost row above: the cells between two slabs are the lower one's
   write_body(out, pvtu_piece_name(path, s.rank), P, s.y_begin, s.y_end + s.hi, u_local.data(), s.local,
              s.y_begin - s.lo, c, format);

@@ -31,7 +31,7 @@ VtkFormat parse_vtk_format(const std::string& s, const std::string& option);
 // xz) and von_mises [Pa]; the contact face (quads, with the same point data)
 // goes to vtu_companion(path). Every file says so in an XML comment
 // (docs/outputs.md). Returns the second file's path.
-std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const std::vector<real>& u_full,
+std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P, const Field<real>& u_full,
                       const ContactFields& c, VtkFormat format = VtkFormat::binary);
 
 // Several ranks (ParaView's parallel format): every rank writes its rows of
@@ -41,7 +41,7 @@ std::string write_vtu(OutputSet& out, const std::string& path, const Problem& P,
 // contact face to vtu_companion(path) (from the contact vectors, which every
 // rank holds whole). Returns the face file's path on rank 0, "" elsewhere.
 std::string write_pvtu(OutputSet& out, const std::string& path, const Problem& P, const Slab& s,
-                       const std::vector<real>& u_local, const ContactFields& c, VtkFormat format = VtkFormat::binary);
+                       const Field<real>& u_local, const ContactFields& c, VtkFormat format = VtkFormat::binary);
 std::string pvtu_piece_name(const std::string& path, int rank);
 
 // A ParaView collection: each (time, file) is one step; a step's files are

@@ -27,7 +27,7 @@ InteriorSolution solve_interior_elasticity(const Problem& P, const Multigrid& mg
   s.stats = pcg(K, &mg, b.data(), s.u.data(), o, ws);
   s.seconds = wall_time() - t0;
   s.fine_matvecs = s.stats.operator_applications + s.stats.preconditioner_applications * mg.cycle_work();
-  std::vector<real>& r = ws.r;  // reuse as scratch
+  Field<real>& r = ws.r;  // reuse as scratch
   K.update_ghosts(s.u.data());
   K.residual(b.data(), s.u.data(), r.data());
   s.relative_residual = s.stats.rhs_norm > 0 ? norm(r.data()) / s.stats.rhs_norm : norm(r.data());

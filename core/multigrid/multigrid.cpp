@@ -276,7 +276,7 @@ void Multigrid::set_bottom_block(const std::vector<real>& B) {
   if (!B.empty() && index(B.size()) != 4 * g0.nx() * g0.ny())
     throw std::invalid_argument("multigrid: bottom block has " + std::to_string(B.size()) + " entries, expected 4 x " +
                                 std::to_string(g0.nx() * g0.ny()));
-  std::vector<real> Bl = B;  // this level's, whole plane
+  Field<real> Bl(B.begin(), B.end());  // this level's, whole plane
   for (size_t l = 0; l < levels_.size(); ++l) {
     const ElasticityOperator& A = levels_[l].A;
     zero_constrained_bottom_block(grids_->levels[l].grid, A.global_faces(), Bl);

@@ -6,8 +6,8 @@
 
 namespace tresca {
 
-real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const std::vector<real>& dinv,
-                  std::vector<real> r, const Reduction* reduce) {
+real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const Field<real>& dinv,
+                  Field<real> r, const Reduction* reduce) {
   // Lanczos through Jacobi-PCG: T_jj = 1/a_j + b_{j-1}/a_{j-1}, T_j,j+1 = sqrt(b_j)/a_j
   auto global = [&](real s) { return reduce ? reduce->sum(s) : s; };
   Field<real> x(n, 0), z(n), p(n), q(n);
@@ -38,11 +38,11 @@ real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const
   return 1.15 * std::max(es.eigenvalues().maxCoeff(), real(2));
 }
 
-std::vector<real> project_bottom_block(const Transfer& t, const std::vector<real>& Bf) {
+Field<real> project_bottom_block(const Transfer& t, const Field<real>& Bf) {
   const GridDims &fg = t.fine, &cg = t.coarse;
   const index Mf = fg.nx() * fg.ny(), Mc = cg.nx() * cg.ny();
   const Interp1D &X = t.axis[0], &Y = t.axis[1];
-  std::vector<real> Bc(4 * Mc, 0.0);
+  Field<real> Bc(4 * Mc, 0.0);
   for (int fld = 0; fld < 4; ++fld)
     for (index jy = 0; jy < cg.ny(); ++jy)
       for (index jx = 0; jx < cg.nx(); ++jx) {

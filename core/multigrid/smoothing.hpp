@@ -40,10 +40,10 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
 
 // r: the start vector (overwritten); apply(p, q): q = A p (p is the
 // estimate's own vector: apply may update its ghost entries)
-real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const std::vector<real>& dinv,
-                  std::vector<real> r, const Reduction* reduce = nullptr);
+real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const Field<real>& dinv,
+                  Field<real> r, const Reduction* reduce = nullptr);
 
 // the coarse bottom block P^T B of the fine one (4 fields of nx*ny each)
-std::vector<real> project_bottom_block(const Transfer& t, const std::vector<real>& fine);
+Field<real> project_bottom_block(const Transfer& t, const Field<real>& fine);
 
 }  // namespace tresca
