@@ -86,8 +86,11 @@ template <class Body>
 inline void for_each_entry(index n, Cost per_entry, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
-    const Body b = body;  // the body's captures (device pointers, scalars) travel by value
-#pragma omp target teams distribute parallel for simd map(to : b)
+    // a copy of the body, mapped implicitly: its captures (device pointers,
+    // scalars) travel by value (GCC 12 fails on a lambda in a map or
+    // firstprivate clause: an internal compiler error)
+    Body b = body;
+#pragma omp target teams distribute parallel for simd
     for (index i = 0; i < n; ++i) b(i);
     return;
   }
@@ -144,8 +147,8 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
   }
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
-    const Block bl = block;
-#pragma omp target teams distribute parallel for map(to : bl) map(from : part[0:nb])
+    Block bl = block;
+#pragma omp target teams distribute parallel for map(from : part[0 : nb])
     for (index b = 0; b < nb; ++b) part[b] = bl(b * width, b + 1 < nb ? (b + 1) * width : n);
   } else
 #endif

@@ -13,6 +13,7 @@
 
 #include "core/multigrid/multigrid.hpp"
 #include "core/fem/problem.hpp"
+#include "kernels/launch.hpp"
 #include "kernels/simd.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
@@ -100,6 +101,39 @@ void BM_Dot(benchmark::State& st) {
 }
 BENCHMARK(BM_Dot)->Name("Dot")->Arg(1 << 20)->Arg(1 << 24)->UseRealTime();
 
+// The same vector kernels through the device backend (kernels/launch.hpp):
+// their vectors in device memory, launched as target regions (a
+// TRESCA_OFFLOAD build; on the host where there is no GPU, "device" in the
+// context header says which). The timed loop is the kernel alone: no copies.
+template <int kKernel>  // 0: dot, 1: axpy, 2: cg_update
+void BM_Device(benchmark::State& st) {
+  if (!offload_built()) {
+    st.SkipWithError("built without TRESCA_OFFLOAD (no device backend)");
+    return;
+  }
+  const index n = index(st.range(0));
+  const std::vector<real> h = ramp(n);
+  const std::size_t bytes = std::size_t(n) * sizeof(real);
+  real* v[4];
+  for (real*& p : v) {
+    p = static_cast<real*>(device_allocate(bytes));
+    copy_to_device(p, h.data(), bytes);
+  }
+  set_launch_on_device(true);
+  for (auto _ : st) {
+    if (kKernel == 0) benchmark::DoNotOptimize(dot(n, v[0], v[1]));
+    if (kKernel == 1) axpy(n, 1e-9, v[0], v[1]);
+    if (kKernel == 2) benchmark::DoNotOptimize(cg_update(n, 1e-9, v[0], v[1], v[2], v[3]));
+  }
+  set_launch_on_device(false);
+  for (real* p : v) device_free(p);
+  const Cost c = kKernel == 0 ? kDotCost : kKernel == 1 ? kAxpyCost : kCgUpdateCost;
+  set_rates(st, double(n), c.bytes, c.flops);
+}
+BENCHMARK_TEMPLATE(BM_Device, 0)->Name("DeviceDot")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_Device, 1)->Name("DeviceAxpy")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_Device, 2)->Name("DeviceCgUpdate")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
+
 }  // namespace
 }  // namespace tresca
 
@@ -108,7 +142,9 @@ static const char* kHelp =
     "The kernels one by one on the fields of mesh levels 6-12 (Apply, ApplyFloat, ApplyRef: the\n"
     "serial _ref twin, VCycle, RestrictProlong, Dot), each with the counters DoF/s, bytes/s and\n"
     "FLOP/s from the kernels' cost models, omp_threads and dofs; the build (ISA, vector width,\n"
-    "compiler) is in the context header.\n"
+    "compiler) and the offload device are in the context header. DeviceDot, DeviceAxpy and\n"
+    "DeviceCgUpdate: the vector kernels in device memory through the offload backend\n"
+    "(a -DTRESCA_OFFLOAD=ON build; otherwise they are skipped with that message).\n"
     "  --benchmark_filter=REGEX        which ones, e.g. 'Apply/10|VCycle/10'\n"
     "  --benchmark_repetitions=N       repeat each; with --benchmark_report_aggregates_only=true\n"
     "                                  only the mean, median, stddev and cv are printed\n"
@@ -132,6 +168,7 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--help-benchmark")) argv[i] = benchmark_help;
   }
   benchmark::AddCustomContext("tresca kernels", tresca::build_info());
+  benchmark::AddCustomContext("device", tresca::device_description());
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -43,28 +43,6 @@ double best_of(int reps, const std::function<void()>& f) {
   return best_time(reps, f);
 }
 
-// STREAM triad, bytes per second as STREAM counts them (24 per entry)
-double triad_bandwidth(tresca::index n, int reps) {
-  std::vector<real> a, b, c;
-  a.reserve(n);
-  b.reserve(n);
-  c.reserve(n);
-  real *pa = a.data(), *pb = b.data(), *pc = c.data();
-#pragma omp parallel for schedule(static)
-  for (tresca::index i = 0; i < n; ++i) {
-    pa[i] = 0;
-    pb[i] = 1;
-    pc[i] = 2;
-  }
-  const real s = 3;
-  const double t = best_of(reps, [&] {
-#pragma omp parallel for simd schedule(static)
-    for (tresca::index i = 0; i < n; ++i) pa[i] = pb[i] + s * pc[i];
-  });
-  if (pa[n / 2] != 7) std::fprintf(stderr, "roofline: triad check failed\n");
-  return 24.0 * double(n) / t;
-}
-
 // peak flop/s of the build's vectors of T: K independent FMA chains per thread
 template <class T>
 double fma_peak(long iterations) {

@@ -32,7 +32,9 @@ static const char* kHelp =
     "Whole contact solves on each level A..B with each thread count, one row per (level, threads):\n"
     "times per phase, Newton / outer / inner iterations, S applications, fine-grid matvec\n"
     "equivalents (fmv) per Newton step and per solve, against one MG-CG solve of K_ii to 1e-10\n"
-    "on the same mesh, peak memory and the speed-up over the first thread count.\n"
+    "on the same mesh, peak memory, the speed-up over the first thread count, the bandwidth-ideal\n"
+    "speed-up (the STREAM triad's ratio, measured at start with each thread count) and the\n"
+    "efficiency (speed-up / bandwidth-ideal: 1 = as fast as the memory allows).\n"
     "  --levels A-B       mesh levels (default 4-10)\n"
     "  --threads T1,T2    thread counts (default 1,2)\n"
     "  --repeat N         solve each (level, threads) N times (default 1); the row is the run of\n"
@@ -41,7 +43,8 @@ static const char* kHelp =
     "  --coulomb F        Coulomb friction instead;  --coulomb-method newton|lagged|fixed-point\n"
     "  --no-nested        start every Newton from x0 = 0 on its own mesh\n"
     "  --json FILE        the rows as JSON (the run-summary schema plus speedup, repeats,\n"
-    "                     total_seconds_runs, fine_matvecs_linear_solve, contact_over_linear)\n"
+    "                     total_seconds_runs, fine_matvecs_linear_solve, contact_over_linear,\n"
+    "                     triad_bytes_per_second, bandwidth_ideal_speedup, efficiency)\n"
     "  -h, --help         this text;  --version  the version and the build (ISA, compiler)\n"
     "Exit status: 0 all converged, 1 some did not, 2 bad input.\n";
 
@@ -74,15 +77,26 @@ int main(int argc, char** argv) {
     for (int L : levels) check_memory(spec_for_level(L));
     warn_if_cores_busy();
     std::printf("# kernels: %s\n", build_info().c_str());
+    // the machine's own bandwidth with each thread count, measured now: a
+    // bandwidth-bound solve can speed up by the triad's ratio at most
+    std::vector<double> triad;
+    for (int T : threads) {
+      omp_set_num_threads(T);
+      triad.push_back(triad_bandwidth(tresca::index(1) << 24, 5));
+    }
+    std::printf("# STREAM triad (3 x 128 MiB, best of 5) with");
+    for (size_t k = 0; k < threads.size(); ++k) std::printf(" %d: %.1f GB/s%s", threads[k], triad[k] / 1e9, k + 1 < threads.size() ? "," : "\n");
+    std::printf("# speedup: over the first thread count; bw-ideal: the triad's ratio; eff: speedup / bw-ideal\n");
     std::printf("# fmv: fine-grid matvec equivalents (the solvers' work counts); fmv K_ii: one MG-CG solve of K_ii to 1e-10\n");
     std::printf("# nested iteration %s; newton, outer, inner, S-app, fmv/step: this mesh; fmv nest: the coarser meshes;\n"
                 "# fmv/solve: all of it (coarser meshes, |b~|, Newton, final check and recovery); condense: the loose |b~|\n",
                 nested ? "on" : "off (--no-nested)");
     if (friction.is_coulomb())
       std::printf("# Coulomb F = %g: fp = fixed-point iterations (Tresca solves), newton = all their steps\n", friction.F);
-    std::printf("%5s %3s %10s %8s %8s %8s %8s %8s %8s %4s %6s %6s %6s %6s %8s %8s %9s %8s %6s %8s %7s\n", "level", "thr",
+    std::printf("%5s %3s %10s %8s %8s %8s %8s %8s %8s %4s %6s %6s %6s %6s %8s %8s %9s %8s %6s %8s %7s", "level", "thr",
                 "dofs", "nested", "setup", "condense", "solve", "recover", "total", "fp", "newton", "outer", "inner", "S-app",
                 "fmv/step", "fmv nest", "fmv/solve", "fmv K_ii", "ratio", "peak GB", "speedup");
+    std::printf(" %8s %5s\n", "bw-ideal", "eff");
     if (repeat > 1)
       std::printf("# each row: the median of %lld solves by total time; [min-max] of their totals after it\n", repeat);
     bool all_converged = true;
@@ -102,7 +116,8 @@ int main(int argc, char** argv) {
         fmv_linear = lin.fine_matvecs;
       }
       double t_first = 0;
-      for (int T : threads) {
+      for (size_t k = 0; k < threads.size(); ++k) {
+        const int T = threads[k];
         omp_set_num_threads(T);
         RunOptions o;
         o.recover_interior = true;
@@ -138,9 +153,9 @@ int main(int argc, char** argv) {
         const size_t med = order[(order.size() - 1) / 2];
         const double total = totals[med];
         if (T == threads.front()) t_first = total;
-        const double speedup = t_first / total;
+        const double speedup = t_first / total, bw_ideal = triad[k] / triad.front();
         char tail[96];
-        std::snprintf(tail, sizeof tail, " %7.2f", speedup);
+        std::snprintf(tail, sizeof tail, " %7.2f %8.2f %5.2f", speedup, bw_ideal, speedup / bw_ideal);
         std::string range;
         if (repeat > 1) {
           char r[64];
@@ -151,6 +166,9 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
         Json j = summaries[med];
         j["speedup"] = speedup;
+        j["triad_bytes_per_second"] = triad[k];
+        j["bandwidth_ideal_speedup"] = bw_ideal;
+        j["efficiency"] = speedup / bw_ideal;
         j["repeats"] = repeat;
         j["total_seconds_runs"] = totals;
         rows.push_back(std::move(j));

@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <stdexcept>
+
+#include "kernels/launch.hpp"
 
 namespace tresca {
 
@@ -20,6 +23,22 @@ const char* kernel_name(Kernel k) {
 }
 
 double wall_time() { return omp_get_wtime(); }
+
+double triad_bandwidth(index n, int reps) {
+  Field<real> a(n), b(n), c(n);  // (first touched here, by one thread: one NUMA node assumed)
+  real *pa = a.data(), *pb = b.data(), *pc = c.data();
+  constexpr Cost kTriad{24, 2};
+  for_each_entry(n, kTriad, [=](index i) {
+    pb[i] = 1;
+    pc[i] = 2;
+  });
+  const real s = 3;
+  auto triad = [&] { for_each_entry(n, kTriad, [=](index i) { pa[i] = pb[i] + s * pc[i]; }); };
+  triad();  // warm-up
+  const double t = best_time(reps, triad);
+  if (pa[n / 2] != 7) throw std::runtime_error("triad_bandwidth: the triad computed a wrong value");
+  return 24.0 * double(n) / t;
+}
 
 double peak_memory_bytes() {
   struct rusage ru;

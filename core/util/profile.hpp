@@ -54,6 +54,12 @@ double best_time(int reps, F&& f) {
 }
 // peak resident memory of this process so far, in bytes (getrusage)
 double peak_memory_bytes();
+// STREAM triad a = b + s c over n doubles with the current thread count,
+// through the launch layer: bytes per second as STREAM counts them (24 per
+// entry, no write-allocate), the best of `reps` after a warm-up. The
+// machine's own bandwidth, the yardstick of the roofline and of scaling's
+// bandwidth-ideal speed-up. Throws if the triad computes a wrong value.
+double triad_bandwidth(index n, int reps);
 
 // Times a scope as kernel k. Timers are made and ended on the driver's
 // (serial) thread, innermost last; each one knows the timer it runs in.
