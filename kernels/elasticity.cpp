@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "element.hpp"
 #include "launch.hpp"
@@ -251,6 +252,91 @@ template void elasticity_apply<double>(const ElasticityStencilT<double>&, const 
                                        const double*);
 template void elasticity_apply<float>(const ElasticityStencilT<float>&, const float*, float*, const RowBlock&,
                                       const float*);
+
+template <class T>
+StencilView<T> host_view(const ElasticityStencilT<T>& k) {
+  return StencilView<T>{k.g,          {k.cls[0].data(), k.cls[1].data(), k.cls[2].data()},
+                        k.run_begin.data(), index(k.run_begin.size()) - 1,
+                        k.slot.data(), k.first.data(), k.groups.data()};
+}
+template StencilView<double> host_view(const ElasticityStencilT<double>&);
+template StencilView<float> host_view(const ElasticityStencilT<float>&);
+
+template <class T>
+DeviceStencil<T>::DeviceStencil(const ElasticityStencilT<T>& k) : v_(host_view(k)) {
+  auto copy = [&](const auto& field) {
+    using E = typename std::decay_t<decltype(field)>::value_type;
+    const std::size_t bytes = field.size() * sizeof(E);
+    void* p = device_allocate(bytes);
+    blocks_.push_back(p);
+    copy_to_device(p, field.data(), bytes);
+    return static_cast<const E*>(p);
+  };
+  for (int a = 0; a < 3; ++a) v_.cls[a] = copy(k.cls[a]);
+  v_.run_begin = copy(k.run_begin);
+  v_.slot = copy(k.slot);
+  v_.first = copy(k.first);
+  v_.groups = copy(k.groups);
+}
+template <class T>
+DeviceStencil<T>::~DeviceStencil() {
+  for (void* p : blocks_) device_free(p);
+}
+template class DeviceStencil<double>;
+template class DeviceStencil<float>;
+
+template <class T>
+void elasticity_apply_rows(const StencilView<T>& k, const T* x, T* y, const RowBlock& rows, const T* b) {
+  const index nx = k.g.nx(), ny = k.g.ny(), N = k.g.nodes(), nruns = k.nruns;
+  TRESCA_ASSERT(0 <= rows.z_begin && rows.z_begin <= rows.z_end && rows.z_end <= k.g.nz());
+  TRESCA_ASSERT(0 <= rows.y_begin && rows.y_begin <= rows.y_end && rows.y_end <= ny);
+  TRESCA_ASSERT(x != y && (b == nullptr || b != y));
+  const std::uint8_t *c0 = k.cls[0], *c1 = k.cls[1], *c2 = k.cls[2];
+  const index* run_begin = k.run_begin;
+  const std::int32_t *slot = k.slot, *first = k.first;
+  const StencilGroupT<T>* groups = k.groups;
+  const index z0 = rows.z_begin, y0 = rows.y_begin;
+  const index nz = rows.z_end - rows.z_begin, nyr = rows.y_end - rows.y_begin;
+  const double nodes = double(nx) * double(nz) * double(nyr);
+  for_each_block(nz, nyr, nodes * in_precision<T>(kApplyCost), [=](index jz, index jy) {
+    const index iz = z0 + jz, iy = y0 + jy;
+    const std::uint8_t cy = c1[iy], cz = c2[iz];
+    const index row = nx * (iy + ny * iz);
+    const bool row_fixed = (cy & kSelf) || (cz & kSelf);
+    const T* xr = x + row;
+    T* yr = y + row;
+    const T* br = b ? b + row : nullptr;
+    for (index r = 0; r < nruns; ++r) {
+      const index i0 = run_begin[r], i1 = run_begin[r + 1];
+      const std::uint8_t cx = c0[i0];
+      if (row_fixed || (cx & kSelf)) {
+        for (int a = 0; a < 3; ++a)
+#pragma omp simd
+          for (index i = i0; i < i1; ++i) yr[a * N + i] = br ? br[a * N + i] - xr[a * N + i] : xr[a * N + i];
+        continue;
+      }
+      const std::int32_t* f = first + 7 * slot[(cx * 32 + cy) * 32 + cz];
+      const StencilGroupT<T>*q0 = groups + f[0], *q1 = groups + f[7];
+#pragma omp simd
+      for (index i = i0; i < i1; ++i) {
+        T acc0 = 0, acc1 = 0, acc2 = 0;
+        for (const StencilGroupT<T>* q = q0; q != q1; ++q) {
+          const T v = xr[i + q->off];
+          acc0 += q->c[0] * v;
+          acc1 += q->c[1] * v;
+          acc2 += q->c[2] * v;
+        }
+        yr[i] = br ? br[i] - acc0 : acc0;
+        yr[N + i] = br ? br[N + i] - acc1 : acc1;
+        yr[2 * N + i] = br ? br[2 * N + i] - acc2 : acc2;
+      }
+    }
+  });
+}
+template void elasticity_apply_rows<double>(const StencilView<double>&, const double*, double*, const RowBlock&,
+                                            const double*);
+template void elasticity_apply_rows<float>(const StencilView<float>&, const float*, float*, const RowBlock&,
+                                           const float*);
 
 template <class T>
 void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_begin, index z_end, const T* b) {

@@ -102,6 +102,47 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
 void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
                           const real* b = nullptr);
 
+// The arrays an apply reads, as plain pointers: a stencil's own (host_view)
+// or their copies in device memory (DeviceStencil).
+template <class T>
+struct StencilView {
+  GridDims g;
+  const std::uint8_t* cls[3];
+  const index* run_begin;
+  index nruns;
+  const std::int32_t* slot;
+  const std::int32_t* first;
+  const StencilGroupT<T>* groups;
+};
+template <class T>
+StencilView<T> host_view(const ElasticityStencilT<T>& k);
+// Copies of a stencil's arrays in device memory (kernels/launch.hpp), freed
+// with it; view() points at them.
+template <class T>
+class DeviceStencil {
+ public:
+  explicit DeviceStencil(const ElasticityStencilT<T>& k);
+  ~DeviceStencil();
+  DeviceStencil(const DeviceStencil&) = delete;
+  DeviceStencil& operator=(const DeviceStencil&) = delete;
+  const StencilView<T>& view() const { return v_; }
+
+ private:
+  std::vector<void*> blocks_;
+  StencilView<T> v_;
+};
+// The same y = K x (or b - K x) parallel over node rows, one (z, y) row per
+// block with the nodes of its x-runs in `omp simd` lanes: the device's form
+// (a GPU warp per row, its lanes along x: coalesced), run as a target region
+// while launch_on_device() holds (x, y, b and k's arrays then in device
+// memory), and on host threads otherwise (then slower than the banded
+// elasticity_apply, whose explicit vectors and cache bands suit the CPU; the
+// tests hold both to elasticity_apply_ref). The same per-node sums in the
+// same order as elasticity_apply, equal to rounding (multiply-adds fuse
+// differently in the two loops).
+template <class T>
+void elasticity_apply_rows(const StencilView<T>& k, const T* x, T* y, const RowBlock& rows, const T* b = nullptr);
+
 // d = diag(K) (1 on constrained dofs). Per node: writes 3 values.
 constexpr Cost kDiagonalCost{24, 0};
 void elasticity_diagonal(const ElasticityStencil& k, real* d);

@@ -56,13 +56,13 @@ using Field = std::vector<T, FieldAllocator<T>>;
 
 // The device backend (a build with TRESCA_OFFLOAD, CMake option of that
 // name: g++-12 with gcc-12-offload-nvptx). While launch_on_device() is
-// true, for_each_entry and sum_over_blocks run their bodies as OpenMP
+// true, for_each_entry, sum_over_blocks and the n1 x n0 for_each_block run their bodies as OpenMP
 // target regions (`target teams distribute parallel for simd`) on the
 // default device, over pointers that must then be device pointers
 // (device_allocate); without a GPU the target regions run on the host.
-// Only these two launchers have a device branch so far: the vector
-// operations. The stencil applies, transfers and smoothers, and Field
-// storage on the device, are issue 22's next steps. Without
+// The 1D for_each_block (the banded CPU apply) and the launcher with
+// scratch (the transfers) have no device branch yet, nor has Field storage:
+// issue 22's next steps. Without
 // TRESCA_OFFLOAD, launch_on_device() is false and set_launch_on_device
 // refuses true.
 bool launch_on_device();
@@ -111,6 +111,15 @@ inline void for_each_block(index n, Cost work, const Body& body) {
 // body(j, i) for every block of an n1 x n0 range (j slow, i fast).
 template <class Body>
 inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
+#ifdef TRESCA_OFFLOAD
+  if (launch_on_device()) {  // one block per (team) thread; the body's own `omp simd` loops in its lanes
+    Body b = body;
+#pragma omp target teams distribute parallel for collapse(2)
+    for (index j = 0; j < n1; ++j)
+      for (index i = 0; i < n0; ++i) b(j, i);
+    return;
+  }
+#endif
 #pragma omp parallel for collapse(2) schedule(static) if (worth_threads(work))
   for (index j = 0; j < n1; ++j)
     for (index i = 0; i < n0; ++i) body(j, i);

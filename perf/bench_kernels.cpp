@@ -130,6 +130,35 @@ void BM_Device(benchmark::State& st) {
   const Cost c = kKernel == 0 ? kDotCost : kKernel == 1 ? kAxpyCost : kCgUpdateCost;
   set_rates(st, double(n), c.bytes, c.flops);
 }
+// The stencil apply on the device (its row form, elasticity_apply_rows),
+// stencil and vectors in device memory; T = double, float
+template <class T>
+void BM_DeviceApply(benchmark::State& st) {
+  if (!offload_built()) {
+    st.SkipWithError("built without TRESCA_OFFLOAD (no device backend)");
+    return;
+  }
+  const Problem P = make_problem(spec_for_level(int(st.range(0))));
+  const ElasticityStencil k64 = build_elasticity_stencil(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+  const ElasticityStencilT<T> k = stencil_in_precision<T>(k64);
+  const index n = k.size();
+  const std::vector<real> h = ramp(n);
+  const std::vector<T> ht(h.begin(), h.end());
+  const DeviceStencil<T> dk(k);
+  T* x = static_cast<T*>(device_allocate(n * sizeof(T)));
+  T* y = static_cast<T*>(device_allocate(n * sizeof(T)));
+  copy_to_device(x, ht.data(), n * sizeof(T));
+  const RowBlock all{0, P.grid.nz(), 0, P.grid.ny()};
+  set_launch_on_device(true);
+  for (auto _ : st) elasticity_apply_rows(dk.view(), x, y, all);
+  set_launch_on_device(false);
+  device_free(x);
+  device_free(y);
+  set_rates(st, double(n), in_precision<T>(kApplyCost).bytes / 3, kApplyCost.flops / 3);
+}
+BENCHMARK_TEMPLATE(BM_DeviceApply, double)->Name("DeviceApply")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_DeviceApply, float)->Name("DeviceApplyFloat")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
+
 BENCHMARK_TEMPLATE(BM_Device, 0)->Name("DeviceDot")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
 BENCHMARK_TEMPLATE(BM_Device, 1)->Name("DeviceAxpy")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
 BENCHMARK_TEMPLATE(BM_Device, 2)->Name("DeviceCgUpdate")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();

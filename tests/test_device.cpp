@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "kernels/elasticity.hpp"
 #include "kernels/launch.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"
@@ -77,6 +78,30 @@ TEST(Device, VectorKernelsOnTheDeviceMatchTheHost) {
     EXPECT_NEAR(drr, hrr, 1e-13 * hrr) << "cg_update, n = " << n;
     EXPECT_LT(test::max_abs_diff(dx2.host(), hx), 1e-15) << "cg_update x, n = " << n;
     EXPECT_LT(test::max_abs_diff(dr.host(), hr), 1e-15) << "cg_update r, n = " << n;
+  }
+}
+
+// the stencil apply in its row form, stencil and vectors in device memory,
+// against the banded apply on the host, plain and fused, double and float
+TEST(Device, StencilApplyOnTheDeviceMatchesTheHost) {
+  if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
+  for (unsigned faces : {0u, unsigned(kFaceX0 | kFaceZ0)}) {
+    const GridDims g = test::prism(21, 6, 5);
+    const ElasticityStencil k = build_elasticity_stencil(g, faces, 1.0, 0.3);
+    const auto x = test::random_vector(k.size(), 8), b = test::random_vector(k.size(), 9);
+    const RowBlock all{0, g.nz(), 0, g.ny()};
+    std::vector<real> hy(k.size()), hr(k.size());
+    elasticity_apply(k, x.data(), hy.data(), all);
+    elasticity_apply(k, x.data(), hr.data(), all, b.data());
+    const DeviceStencil<real> dk(k);
+    DeviceVector dx(x), db(b), dy(std::vector<real>(k.size(), 7.0)), dr(std::vector<real>(k.size(), 7.0));
+    {
+      OnDevice on;
+      elasticity_apply_rows(dk.view(), dx.p, dy.p, all);
+      elasticity_apply_rows(dk.view(), dx.p, dr.p, all, db.p);
+    }
+    EXPECT_LE(test::max_abs_diff(dy.host(), hy), 1e-14 * test::max_abs(hy)) << "faces " << faces;
+    EXPECT_LE(test::max_abs_diff(dr.host(), hr), 1e-14 * test::max_abs(hr)) << "faces " << faces;
   }
 }
 
