@@ -10,10 +10,10 @@
 //     thread the same entries, and so the pages it touched first;
 //   - the `_ref` twins are plain serial loops beside each kernel (the
 //     independent oracle of the tests, not a backend);
-//   - an offload backend is a second definition of these launchers (`omp
-//     target teams distribute parallel for simd` over the same bodies) and
-//     of Field, which then allocates where the device runs. Nothing above
-//     kernels/ names OpenMP's loop constructs.
+//   - the device (a TRESCA_OFFLOAD build, below): a second branch inside
+//     the same launchers, `omp target teams distribute parallel for [simd]`
+//     over the same bodies. Nothing above kernels/ names OpenMP's loop
+//     constructs.
 //
 // Field<T> is the storage of everything the linear machinery sweeps: the
 // operators' stencils and diagonals, every multigrid level's vectors, the
@@ -29,7 +29,7 @@
 
 namespace tresca {
 
-// Host storage of a Field: large arrays (>= 4 MiB) are aligned to 2 MiB and
+// Host storage of a Field: large arrays (>= 1 MiB) are aligned to 2 MiB and
 // marked MADV_HUGEPAGE, so where the kernel's transparent-huge-page mode is
 // "madvise" (Debian's default) their first touch costs one page fault per
 // 2 MiB instead of per 4 KiB (perf/RESULTS.md §0d, §0k). Smaller arrays come
@@ -56,13 +56,12 @@ using Field = std::vector<T, FieldAllocator<T>>;
 
 // The device backend (a build with TRESCA_OFFLOAD, CMake option of that
 // name: g++-12 with gcc-12-offload-nvptx). While launch_on_device() is
-// true, for_each_entry, sum_over_blocks and the n1 x n0 for_each_block run their bodies as OpenMP
-// target regions (`target teams distribute parallel for simd`) on the
-// default device, over pointers that must then be device pointers
-// (device_allocate); without a GPU the target regions run on the host.
-// The 1D for_each_block (the banded CPU apply) and the launcher with
-// scratch (the transfers) have no device branch yet, nor has Field storage:
-// issue 22's next steps. Without
+// true, for_each_entry, sum_over_blocks and the n1 x n0 for_each_block run
+// their bodies as OpenMP target regions on the default device, over
+// pointers that must then be device pointers (device_allocate); without a
+// GPU the target regions run on the host. The 1D for_each_block (the banded
+// CPU apply) and the launcher with scratch (the transfers) have no device
+// branch yet, nor has Field storage: issue 22's next steps. Without
 // TRESCA_OFFLOAD, launch_on_device() is false and set_launch_on_device
 // refuses true.
 bool launch_on_device();
@@ -74,7 +73,7 @@ void* device_allocate(std::size_t bytes);
 void device_free(void* p) noexcept;
 void copy_to_device(void* device, const void* host, std::size_t bytes);
 void copy_from_device(void* host, const void* device, std::size_t bytes);
-// "NVIDIA ... (device 0 of 1)" or "none: target regions run on the host"
+// "device 0 of 1 (OpenMP offload)", or "none: target regions run on the host"
 std::string device_description();
 
 // How many workers a launch has (threads on the host): a kernel that cuts

@@ -5,6 +5,9 @@
 // nvptx and runs it through the target-region code path); a build
 // without offload skips them and says so.
 #include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cstdlib>
 
 #include <algorithm>
 #include <cmath>
@@ -45,6 +48,14 @@ struct OnDevice {
 
 const index kLengths[] = {1, 7, kDotBlock - 1, kDotBlock + 1, 5 * kDotBlock + 43, 100003};
 }  // namespace
+
+// where a GPU run is meant (perf/gpu_bundle.sh's run.sh sets it): fail,
+// rather than pass on the host, when no device is there (GCC 12 runs the
+// target regions on the host even with OMP_TARGET_OFFLOAD=MANDATORY)
+TEST(Device, PresentWhereRequired) {
+  if (!std::getenv("TRESCA_REQUIRE_DEVICE")) GTEST_SKIP() << "TRESCA_REQUIRE_DEVICE unset";
+  EXPECT_GT(omp_get_num_devices(), 0) << "no offload device: " << device_description();
+}
 
 TEST(Device, WithoutOffloadTheDeviceIsRefused) {
   if (offload_built()) GTEST_SKIP() << "an offload build: " << device_description();

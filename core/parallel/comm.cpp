@@ -29,11 +29,13 @@ CommCounters& comm_counters() {
   return c;
 }
 
+#ifdef TRESCA_HAVE_MPI
 namespace {
 bool session_started = false;
 // started by an MPI launcher (mpirun / mpiexec, with any rank count)
 bool launched_by_mpi() { return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK"); }
 }  // namespace
+#endif
 
 MpiSession::MpiSession(int& argc, char**& argv) {
 #ifdef TRESCA_HAVE_MPI
