@@ -10,8 +10,12 @@
 //   build/bin/scaling --levels 4-10 --threads 1,2 --json perf/scaling.json
 #include <omp.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <exception>
 #include <sstream>
 #include <stdexcept>
@@ -26,9 +30,104 @@
 
 using namespace tresca;
 
+namespace {
+// "1,2,4" -> {1, 2, 4}, each in 1..1024
+std::vector<int> parse_counts(const std::string& text, const char* option) {
+  std::vector<int> out;
+  std::istringstream is(text);
+  std::string t;
+  while (std::getline(is, t, ',')) {
+    char* end = nullptr;
+    const long v = std::strtol(t.c_str(), &end, 10);
+    if (t.empty() || *end || v < 1 || v > 1024)
+      throw std::invalid_argument(std::string(option) + " entry '" + t + "' is not a count in 1..1024");
+    out.push_back(int(v));
+  }
+  if (out.empty()) throw std::invalid_argument(std::string(option) + " is empty");
+  return out;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// Rank scaling: each (level, R) solved by `mpirun -np R ... tresca` with one
+// thread per rank, its time read from that run's JSON; the bandwidth-ideal
+// speed-up is the triad's with R threads in this process (the same cores'
+// bandwidth). Open MPI's mpirun (its -x and --bind-to).
+bool rank_rows(const std::vector<int>& levels, const std::vector<int>& ranks, long long repeat,
+               const std::string& solver_args, const std::string& mpirun, Json& rows) {
+  char self[4096];
+  const ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+  if (len <= 0) throw std::runtime_error("cannot find this program's directory (/proc/self/exe)");
+  self[len] = 0;
+  const std::string tresca_bin = std::filesystem::path(self).parent_path() / "tresca";
+  const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  std::vector<double> triad;
+  for (int R : ranks) {
+    omp_set_num_threads(R);
+    triad.push_back(triad_bandwidth(tresca::index(1) << 24, 5));
+  }
+  std::printf("# ranks: %s -np R %s --level L %s (1 OpenMP thread per rank)\n", mpirun.c_str(), tresca_bin.c_str(),
+              solver_args.c_str());
+  std::printf("# STREAM triad with R threads in this process (the bandwidth R ranks share):");
+  for (size_t k = 0; k < ranks.size(); ++k) std::printf(" %d: %.1f GB/s", ranks[k], triad[k] / 1e9);
+  std::printf("\n%5s %5s %10s %9s %7s %8s %5s %s\n", "level", "ranks", "dofs", "total", "speedup", "bw-ideal", "eff",
+              repeat > 1 ? "[min-max] newton" : "newton");
+  const std::string json_path = (std::filesystem::temp_directory_path() / ("scaling_ranks_" + std::to_string(getpid()) + ".json")).string();
+  bool all_converged = true;
+  for (int L : levels) {
+    double t_first = 0;
+    for (size_t k = 0; k < ranks.size(); ++k) {
+      const int R = ranks[k];
+      const std::string bind = R <= cores ? "--bind-to core" : "--oversubscribe --bind-to none";
+      const std::string cmd = mpirun + " -np " + std::to_string(R) + " " + bind + " -x OMP_NUM_THREADS=1 " + tresca_bin +
+                              " --level " + std::to_string(L) + " --quiet " + solver_args + " --json " + json_path + " 2>&1";
+      std::vector<double> totals;
+      Json last;
+      for (long long rep = 0; rep < repeat; ++rep) {
+        std::remove(json_path.c_str());
+        std::string out;
+        FILE* p = popen(cmd.c_str(), "r");
+        if (!p) throw std::runtime_error("cannot start: " + cmd);
+        char buf[4096];
+        size_t n;
+        while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+        const int st = pclose(p);
+        const std::string text = slurp(json_path);
+        if (text.empty())
+          throw std::runtime_error("'" + cmd + "' wrote no JSON (exit status " + std::to_string(st) + "):\n" + out);
+        last = Json::parse(text);
+        totals.push_back(last["times"]["total"].get<double>());
+        all_converged = all_converged && last["converged"].get<bool>();
+      }
+      std::remove(json_path.c_str());
+      std::vector<double> sorted = totals;
+      std::sort(sorted.begin(), sorted.end());
+      const double total = sorted[(sorted.size() - 1) / 2];
+      if (k == 0) t_first = total;
+      const double speedup = t_first / total, bw_ideal = triad[k] / triad.front();
+      std::printf("%5d %5d %10lld %9.3f %7.2f %8.2f %5.2f", L, R, last["dofs"].get<long long>(), total, speedup, bw_ideal,
+                  speedup / bw_ideal);
+      if (repeat > 1) std::printf(" [%.3f-%.3f]", sorted.front(), sorted.back());
+      std::printf(" %d%s\n", last["newton_iterations"].get<int>(), last["converged"].get<bool>() ? "" : " NOT CONVERGED");
+      std::fflush(stdout);
+      rows.push_back({{"level", L}, {"ranks", R}, {"threads_per_rank", 1}, {"total_seconds", total},
+                      {"total_seconds_runs", totals}, {"speedup", speedup}, {"triad_bytes_per_second", triad[k]},
+                      {"bandwidth_ideal_speedup", bw_ideal}, {"efficiency", speedup / bw_ideal},
+                      {"newton_iterations", last["newton_iterations"]}, {"converged", last["converged"]}});
+    }
+  }
+  return all_converged;
+}
+}  // namespace
+
 static const char* kHelp =
-    "usage: scaling [--levels A-B] [--threads 1,2,...] [--repeat N] [--phi F | --coulomb F [--coulomb-method M]]\n"
-    "               [--no-nested] [--json FILE]\n"
+    "usage: scaling [--levels A-B] [--threads 1,2,... | --ranks 1,2,... [--mpirun CMD]] [--repeat N]\n"
+    "               [--phi F | --coulomb F [--coulomb-method M]] [--no-nested] [--json FILE]\n"
     "Whole contact solves on each level A..B with each thread count, one row per (level, threads):\n"
     "times per phase, Newton / outer / inner iterations, S applications, fine-grid matvec\n"
     "equivalents (fmv) per Newton step and per solve, against one MG-CG solve of K_ii to 1e-10\n"
@@ -37,6 +136,9 @@ static const char* kHelp =
     "efficiency (speed-up / bandwidth-ideal: 1 = as fast as the memory allows).\n"
     "  --levels A-B       mesh levels (default 4-10)\n"
     "  --threads T1,T2    thread counts (default 1,2)\n"
+    "  --ranks R1,R2      MPI rank counts instead, one thread each: every solve is `mpirun -np R\n"
+    "                     tresca ...` (Open MPI; --mpirun CMD, default mpirun), its time read from\n"
+    "                     its JSON; the bandwidth-ideal speed-up is the triad's with R threads\n"
     "  --repeat N         solve each (level, threads) N times (default 1); the row is the run of\n"
     "                     median total time, with the range of the N totals beside it\n"
     "  --phi F            Tresca friction bound (default 1)\n"
@@ -51,20 +153,11 @@ static const char* kHelp =
 int main(int argc, char** argv) {
   require_one_rank("scaling");
   try {
-    Args a(argc, argv, {"--levels", "--threads", "--repeat", "--phi", "--coulomb", "--coulomb-method", "--json"}, {"--no-nested"});
+    Args a(argc, argv, {"--levels", "--threads", "--ranks", "--mpirun", "--repeat", "--phi", "--coulomb", "--coulomb-method", "--json"},
+           {"--no-nested"});
     if (answered_help_or_version(a, "scaling", kHelp)) return 0;
     const auto levels = parse_level_range(a.str("--levels", "4-10"));
-    std::vector<int> threads;
-    {
-      std::istringstream is(a.str("--threads", "1,2"));
-      std::string t;
-      while (std::getline(is, t, ',')) {
-        char* end = nullptr;
-        const long v = std::strtol(t.c_str(), &end, 10);
-        if (t.empty() || *end || v < 1 || v > 1024) throw std::invalid_argument("--threads entry '" + t + "' is not a thread count");
-        threads.push_back(int(v));
-      }
-    }
+    const std::vector<int> threads = parse_counts(a.str("--threads", "1,2"), "--threads");
     const long long repeat = a.int_value("--repeat", 1);
     if (repeat < 1 || repeat > 1000) throw std::invalid_argument("--repeat " + a.str("--repeat") + " must be in 1..1000");
     const double phi = a.real_value("--phi", 1.0);
@@ -77,6 +170,19 @@ int main(int argc, char** argv) {
     for (int L : levels) check_memory(spec_for_level(L));
     warn_if_cores_busy();
     std::printf("# kernels: %s\n", build_info().c_str());
+    if (a.has("--ranks")) {
+      if (a.has("--threads")) throw std::invalid_argument("--ranks and --threads: one sweep at a time");
+      std::ostringstream args;
+      args << "--phi " << phi << (nested ? "" : " --no-nested");
+      if (friction.is_coulomb())
+        args << " --coulomb " << friction.F << " --coulomb-method " << to_string(friction.method);
+      Json rows = Json::array();
+      const bool ok = rank_rows(levels, parse_counts(a.str("--ranks"), "--ranks"), repeat, args.str(),
+                                a.str("--mpirun", "mpirun"), rows);
+      if (!json.empty()) write_file_atomic(json, json_text(rows));
+      if (!ok) std::fprintf(stderr, "scaling: some solves did not converge (see the last column)\n");
+      return ok ? 0 : 1;
+    }
     // the machine's own bandwidth with each thread count, measured now: a
     // bandwidth-bound solve can speed up by the triad's ratio at most
     std::vector<double> triad;
