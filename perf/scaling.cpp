@@ -15,7 +15,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <exception>
 #include <sstream>
 #include <stdexcept>
@@ -45,13 +44,6 @@ std::vector<int> parse_counts(const std::string& text, const char* option) {
   }
   if (out.empty()) throw std::invalid_argument(std::string(option) + " is empty");
   return out;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
 }
 
 // Rank scaling: each (level, R) solved by `mpirun -np R ... tresca` with one
@@ -97,10 +89,9 @@ bool rank_rows(const std::vector<int>& levels, const std::vector<int>& ranks, lo
         size_t n;
         while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
         const int st = pclose(p);
-        const std::string text = slurp(json_path);
-        if (text.empty())
+        if (!std::filesystem::exists(json_path))
           throw std::runtime_error("'" + cmd + "' wrote no JSON (exit status " + std::to_string(st) + "):\n" + out);
-        last = Json::parse(text);
+        last = Json::parse(read_text_file(json_path, "the run's JSON"));
         totals.push_back(last["times"]["total"].get<double>());
         all_converged = all_converged && last["converged"].get<bool>();
       }

@@ -1,6 +1,8 @@
 #include "core/io/output.hpp"
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -219,6 +221,15 @@ void check_writable(const std::string& path) {
 void write_text(OutputSet& out, const std::string& path, const std::string& contents) {
   std::FILE* f = out.create(path);
   std::fwrite(contents.data(), 1, contents.size(), f);
+}
+
+std::string read_text_file(const std::string& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("cannot read " + what + " '" + path + "'");
+  std::ostringstream os;
+  os << in.rdbuf();
+  if (in.bad()) throw std::invalid_argument("cannot read " + what + " '" + path + "'");
+  return os.str();
 }
 
 void write_file_atomic(const std::string& path, const std::string& contents) {

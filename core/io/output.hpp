@@ -51,6 +51,9 @@ class OutputSet {
 void write_text(OutputSet& out, const std::string& path, const std::string& contents);
 // one file on its own: write_text + publish
 void write_file_atomic(const std::string& path, const std::string& contents);
+// a whole file's contents; throws std::invalid_argument "cannot read
+// <what> '<path>'" if it cannot be opened or read
+std::string read_text_file(const std::string& path, const std::string& what);
 
 // JSON documents (run summaries, perf records): nlohmann's, keys in
 // insertion order; non-finite numbers are written as null. `json_text`

@@ -1,5 +1,7 @@
 #include "core/io/problem_file.hpp"
 
+#include "core/io/output.hpp"
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -181,12 +183,7 @@ ProblemFile parse_problem(const std::string& text, const std::string& origin) {
 }
 
 ProblemFile read_problem_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot read problem file '" + path + "'");
-  std::ostringstream os;
-  os << in.rdbuf();
-  if (in.bad()) throw std::invalid_argument("cannot read problem file '" + path + "'");
-  return parse_problem(os.str(), "problem file '" + path + "'");
+  return parse_problem(read_text_file(path, "problem file"), "problem file '" + path + "'");
 }
 
 std::vector<std::vector<real>> read_contact_csv(const std::string& path, const GridDims& g,
