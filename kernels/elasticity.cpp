@@ -209,6 +209,44 @@ template ElasticityStencilT<float> stencil_in_precision<float>(const ElasticityS
 template ElasticityStencilT<double> stencil_in_precision<double>(const ElasticityStencil&);
 
 template <class T>
+StencilView<T> host_view(const ElasticityStencilT<T>& k) {
+  return StencilView<T>{k.g,          {k.cls[0].data(), k.cls[1].data(), k.cls[2].data()},
+                        k.run_begin.data(), index(k.run_begin.size()) - 1,
+                        k.slot.data(), k.first.data(), k.groups.data()};
+}
+template StencilView<double> host_view(const ElasticityStencilT<double>&);
+template StencilView<float> host_view(const ElasticityStencilT<float>&);
+
+namespace {
+// One node row (iz, iy) of y = K x (or b - K x) over its x-runs: a run of
+// nodes on a constrained face (or the whole row on one) copies x (b - x);
+// every other run hands its stencil (f = first + 7 s) and the row's vectors,
+// offset to the row's first node, to run(f, xr, yr, br, i0, i1). The banded
+// apply and its row form differ only in `run` and in how rows are launched.
+template <class T, class Run>
+inline void sweep_row(const StencilView<T>& k, index nx, index ny, index N, index iz, index iy, const T* x, T* y,
+                      const T* b, const Run& run) {
+  const std::uint8_t cy = k.cls[1][iy], cz = k.cls[2][iz];
+  const index row = nx * (iy + ny * iz);
+  const bool row_fixed = (cy & kSelf) || (cz & kSelf);
+  const T* xr = x + row;
+  T* yr = y + row;
+  const T* br = b ? b + row : nullptr;
+  for (index r = 0; r < k.nruns; ++r) {
+    const index i0 = k.run_begin[r], i1 = k.run_begin[r + 1];
+    const std::uint8_t cx = k.cls[0][i0];
+    if (row_fixed || (cx & kSelf)) {
+      for (int a = 0; a < 3; ++a)
+#pragma omp simd
+        for (index i = i0; i < i1; ++i) yr[a * N + i] = br ? br[a * N + i] - xr[a * N + i] : xr[a * N + i];
+      continue;
+    }
+    run(k.first + 7 * k.slot[(cx * 32 + cy) * 32 + cz], xr, yr, br, i0, i1);
+  }
+}
+}  // namespace
+
+template <class T>
 void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const RowBlock& rows, const T* b) {
   const GridDims& g = k.g;
   const index nx = g.nx(), ny = g.ny(), N = g.nodes();
@@ -216,7 +254,6 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
   TRESCA_ASSERT(0 <= rows.y_begin && rows.y_begin <= rows.y_end && rows.y_end <= ny);
   TRESCA_ASSERT(x != y && (b == nullptr || b != y));  // y is written while x and b are read
   TRESCA_ASSERT(!k.groups.empty());
-  const index nruns = index(k.run_begin.size()) - 1;
   // Cache blocking: each thread sweeps z over a band of about kBand x-rows, so
   // the three input planes of the band (3 x (kBand+2) rows) stay in L2.
   constexpr index kBand = 16;
@@ -225,42 +262,20 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
   const index nbands = std::max<index>(1, width * ((rows_y + width * kBand - 1) / (width * kBand)));
   const index band = (rows_y + nbands - 1) / nbands;
   const double nodes = double(nx) * double(rows_y) * double(rows.z_end - rows.z_begin);
-  for_each_block(nbands, nodes * in_precision<T>(kApplyCost), [&k, x, y, b, rows, nx, ny, N, nruns, band](index bnd) {
+  const StencilView<T> v = host_view(k);
+  for_each_block(nbands, nodes * in_precision<T>(kApplyCost), [v, x, y, b, rows, nx, ny, N, band](index bnd) {
     for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
-      for (index iy = rows.y_begin + bnd * band; iy < std::min(rows.y_end, rows.y_begin + (bnd + 1) * band); ++iy) {
-        const std::uint8_t cy = k.cls[1][iy], cz = k.cls[2][iz];
-        const index row = nx * (iy + ny * iz);
-        const bool row_fixed = (cy & kSelf) || (cz & kSelf);
-        for (index r = 0; r < nruns; ++r) {
-          const index i0 = k.run_begin[r], i1 = k.run_begin[r + 1];
-          const std::uint8_t cx = k.cls[0][i0];
-          if (row_fixed || (cx & kSelf)) {
-            for (int a = 0; a < 3; ++a)
-              for (index i = i0; i < i1; ++i) {
-                const index j = a * N + row + i;
-                y[j] = b ? b[j] - x[j] : x[j];
-              }
-            continue;
-          }
-          const std::int32_t s = k.slot[(cx * 32 + cy) * 32 + cz];
-          stencil_range<T>(k.groups.data(), k.first.data() + 7 * s, x + row, y + row, b ? b + row : nullptr, N, i0, i1);
-        }
-      }
+      for (index iy = rows.y_begin + bnd * band; iy < std::min(rows.y_end, rows.y_begin + (bnd + 1) * band); ++iy)
+        sweep_row(v, nx, ny, N, iz, iy, x, y, b,
+                  [&](const std::int32_t* f, const T* xr, T* yr, const T* br, index i0, index i1) {
+                    stencil_range<T>(v.groups, f, xr, yr, br, N, i0, i1);
+                  });
   });
 }
 template void elasticity_apply<double>(const ElasticityStencilT<double>&, const double*, double*, const RowBlock&,
                                        const double*);
 template void elasticity_apply<float>(const ElasticityStencilT<float>&, const float*, float*, const RowBlock&,
                                       const float*);
-
-template <class T>
-StencilView<T> host_view(const ElasticityStencilT<T>& k) {
-  return StencilView<T>{k.g,          {k.cls[0].data(), k.cls[1].data(), k.cls[2].data()},
-                        k.run_begin.data(), index(k.run_begin.size()) - 1,
-                        k.slot.data(), k.first.data(), k.groups.data()};
-}
-template StencilView<double> host_view(const ElasticityStencilT<double>&);
-template StencilView<float> host_view(const ElasticityStencilT<float>&);
 
 template <class T>
 DeviceStencil<T>::DeviceStencil(const ElasticityStencilT<T>& k) : v_(host_view(k)) {
@@ -287,50 +302,31 @@ template class DeviceStencil<float>;
 
 template <class T>
 void elasticity_apply_rows(const StencilView<T>& k, const T* x, T* y, const RowBlock& rows, const T* b) {
-  const index nx = k.g.nx(), ny = k.g.ny(), N = k.g.nodes(), nruns = k.nruns;
+  const index nx = k.g.nx(), ny = k.g.ny(), N = k.g.nodes();
   TRESCA_ASSERT(0 <= rows.z_begin && rows.z_begin <= rows.z_end && rows.z_end <= k.g.nz());
   TRESCA_ASSERT(0 <= rows.y_begin && rows.y_begin <= rows.y_end && rows.y_end <= ny);
   TRESCA_ASSERT(x != y && (b == nullptr || b != y));
-  const std::uint8_t *c0 = k.cls[0], *c1 = k.cls[1], *c2 = k.cls[2];
-  const index* run_begin = k.run_begin;
-  const std::int32_t *slot = k.slot, *first = k.first;
-  const StencilGroupT<T>* groups = k.groups;
   const index z0 = rows.z_begin, y0 = rows.y_begin;
   const index nz = rows.z_end - rows.z_begin, nyr = rows.y_end - rows.y_begin;
   const double nodes = double(nx) * double(nz) * double(nyr);
   for_each_block(nz, nyr, nodes * in_precision<T>(kApplyCost), [=](index jz, index jy) {
-    const index iz = z0 + jz, iy = y0 + jy;
-    const std::uint8_t cy = c1[iy], cz = c2[iz];
-    const index row = nx * (iy + ny * iz);
-    const bool row_fixed = (cy & kSelf) || (cz & kSelf);
-    const T* xr = x + row;
-    T* yr = y + row;
-    const T* br = b ? b + row : nullptr;
-    for (index r = 0; r < nruns; ++r) {
-      const index i0 = run_begin[r], i1 = run_begin[r + 1];
-      const std::uint8_t cx = c0[i0];
-      if (row_fixed || (cx & kSelf)) {
-        for (int a = 0; a < 3; ++a)
+    sweep_row(k, nx, ny, N, z0 + jz, y0 + jy, x, y, b,
+              [&](const std::int32_t* f, const T* xr, T* yr, const T* br, index i0, index i1) {
+                const StencilGroupT<T>*q0 = k.groups + f[0], *q1 = k.groups + f[7];
 #pragma omp simd
-          for (index i = i0; i < i1; ++i) yr[a * N + i] = br ? br[a * N + i] - xr[a * N + i] : xr[a * N + i];
-        continue;
-      }
-      const std::int32_t* f = first + 7 * slot[(cx * 32 + cy) * 32 + cz];
-      const StencilGroupT<T>*q0 = groups + f[0], *q1 = groups + f[7];
-#pragma omp simd
-      for (index i = i0; i < i1; ++i) {
-        T acc0 = 0, acc1 = 0, acc2 = 0;
-        for (const StencilGroupT<T>* q = q0; q != q1; ++q) {
-          const T v = xr[i + q->off];
-          acc0 += q->c[0] * v;
-          acc1 += q->c[1] * v;
-          acc2 += q->c[2] * v;
-        }
-        yr[i] = br ? br[i] - acc0 : acc0;
-        yr[N + i] = br ? br[N + i] - acc1 : acc1;
-        yr[2 * N + i] = br ? br[2 * N + i] - acc2 : acc2;
-      }
-    }
+                for (index i = i0; i < i1; ++i) {
+                  T acc0 = 0, acc1 = 0, acc2 = 0;
+                  for (const StencilGroupT<T>* q = q0; q != q1; ++q) {
+                    const T v = xr[i + q->off];
+                    acc0 += q->c[0] * v;
+                    acc1 += q->c[1] * v;
+                    acc2 += q->c[2] * v;
+                  }
+                  yr[i] = br ? br[i] - acc0 : acc0;
+                  yr[N + i] = br ? br[N + i] - acc1 : acc1;
+                  yr[2 * N + i] = br ? br[2 * N + i] - acc2 : acc2;
+                }
+              });
   });
 }
 template void elasticity_apply_rows<double>(const StencilView<double>&, const double*, double*, const RowBlock&,
