@@ -19,6 +19,15 @@ void bottom_block_apply(const GridDims& g, T alpha, const T* B, const T* x, T* y
 template void bottom_block_apply<double>(const GridDims&, double, const double*, const double*, double*);
 template void bottom_block_apply<float>(const GridDims&, float, const float*, const float*, float*);
 
+void bottom_block_diagonal(const GridDims& g, const real* B, real* d) {
+  const index M = g.nx() * g.ny(), N = g.nodes();
+  for_each_entry(M, Cost{72, 3}, [=](index n) {
+    d[n] += B[n];
+    d[N + n] += B[2 * M + n];
+    d[2 * N + n] += B[3 * M + n];
+  });
+}
+
 void bottom_block_apply_ref(const GridDims& g, real alpha, const real* B, const real* x, real* y) {
   const index M = g.nx() * g.ny(), N = g.nodes();
   for (index n = 0; n < M; ++n) {

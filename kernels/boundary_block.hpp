@@ -17,5 +17,7 @@ constexpr Cost kBottomBlockCost{104, 13};  // per bottom-face node
 template <class T>
 void bottom_block_apply(const GridDims& g, T alpha, const T* B, const T* x, T* y);
 void bottom_block_apply_ref(const GridDims& g, real alpha, const real* B, const real* x, real* y);
+// d += diag(B) on the bottom face (the Jacobi diagonal of K + B)
+void bottom_block_diagonal(const GridDims& g, const real* B, real* d);
 
 }  // namespace tresca

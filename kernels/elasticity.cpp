@@ -111,6 +111,7 @@ ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, re
 
 ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, real E, real nu,
                                            const std::array<real, 3>& h) {
+  HostLaunches host;  // built entry by entry, then moved where launches run
   ElasticityStencil k;
   k.g = g;
   k.faces = faces;
@@ -181,16 +182,20 @@ ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, re
           }
         }
         for (int m = 1; m < 8; ++m) {
-          k.groups.insert(k.groups.end(), by_mask[m].begin(), by_mask[m].end());
+          for (const StencilGroup& q : by_mask[m]) k.groups.push_back(q);
           k.first.push_back(std::int32_t(k.groups.size()));
         }
         for (int a = 0; a < 3; ++a) k.center.push_back(S[13][a][a]);
       }
+  k.move_to(host.space_before());
   return k;
 }
 
 template <class T>
-ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& k) {
+ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& kk) {
+  HostLaunches host;
+  ElasticityStencil k = kk;
+  k.move_to(Space::host);
   ElasticityStencilT<T> t;
   t.g = k.g;
   t.faces = k.faces;
@@ -203,19 +208,20 @@ ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& k) {
   t.first = k.first;
   for (const StencilGroup& q : k.groups) t.groups.push_back({q.off, {T(q.c[0]), T(q.c[1]), T(q.c[2])}});
   for (real c : k.center) t.center.push_back(T(c));
+  t.move_to(host.space_before());
   return t;
 }
 template ElasticityStencilT<float> stencil_in_precision<float>(const ElasticityStencil&);
 template ElasticityStencilT<double> stencil_in_precision<double>(const ElasticityStencil&);
 
 template <class T>
-StencilView<T> host_view(const ElasticityStencilT<T>& k) {
+StencilView<T> view(const ElasticityStencilT<T>& k) {
   return StencilView<T>{k.g,          {k.cls[0].data(), k.cls[1].data(), k.cls[2].data()},
                         k.run_begin.data(), index(k.run_begin.size()) - 1,
                         k.slot.data(), k.first.data(), k.groups.data()};
 }
-template StencilView<double> host_view(const ElasticityStencilT<double>&);
-template StencilView<float> host_view(const ElasticityStencilT<float>&);
+template StencilView<double> view(const ElasticityStencilT<double>&);
+template StencilView<float> view(const ElasticityStencilT<float>&);
 
 namespace {
 // One node row (iz, iy) of y = K x (or b - K x) over its x-runs: a run of
@@ -254,6 +260,7 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
   TRESCA_ASSERT(0 <= rows.y_begin && rows.y_begin <= rows.y_end && rows.y_end <= ny);
   TRESCA_ASSERT(x != y && (b == nullptr || b != y));  // y is written while x and b are read
   TRESCA_ASSERT(!k.groups.empty());
+  if (launch_on_device()) return elasticity_apply_rows(view(k), x, y, rows, b);  // the device's form
   // Cache blocking: each thread sweeps z over a band of about kBand x-rows, so
   // the three input planes of the band (3 x (kBand+2) rows) stay in L2.
   constexpr index kBand = 16;
@@ -262,7 +269,7 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
   const index nbands = std::max<index>(1, width * ((rows_y + width * kBand - 1) / (width * kBand)));
   const index band = (rows_y + nbands - 1) / nbands;
   const double nodes = double(nx) * double(rows_y) * double(rows.z_end - rows.z_begin);
-  const StencilView<T> v = host_view(k);
+  const StencilView<T> v = view(k);
   for_each_block(nbands, nodes * in_precision<T>(kApplyCost), [v, x, y, b, rows, nx, ny, N, band](index bnd) {
     for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
       for (index iy = rows.y_begin + bnd * band; iy < std::min(rows.y_end, rows.y_begin + (bnd + 1) * band); ++iy)
@@ -276,29 +283,6 @@ template void elasticity_apply<double>(const ElasticityStencilT<double>&, const 
                                        const double*);
 template void elasticity_apply<float>(const ElasticityStencilT<float>&, const float*, float*, const RowBlock&,
                                       const float*);
-
-template <class T>
-DeviceStencil<T>::DeviceStencil(const ElasticityStencilT<T>& k) : v_(host_view(k)) {
-  auto copy = [&](const auto& field) {
-    using E = typename std::decay_t<decltype(field)>::value_type;
-    const std::size_t bytes = field.size() * sizeof(E);
-    void* p = device_allocate(bytes);
-    blocks_.push_back(p);
-    copy_to_device(p, field.data(), bytes);
-    return static_cast<const E*>(p);
-  };
-  for (int a = 0; a < 3; ++a) v_.cls[a] = copy(k.cls[a]);
-  v_.run_begin = copy(k.run_begin);
-  v_.slot = copy(k.slot);
-  v_.first = copy(k.first);
-  v_.groups = copy(k.groups);
-}
-template <class T>
-DeviceStencil<T>::~DeviceStencil() {
-  for (void* p : blocks_) device_free(p);
-}
-template class DeviceStencil<double>;
-template class DeviceStencil<float>;
 
 template <class T>
 void elasticity_apply_rows(const StencilView<T>& k, const T* x, T* y, const RowBlock& rows, const T* b) {
@@ -384,15 +368,18 @@ void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, in
 }
 
 void elasticity_diagonal(const ElasticityStencil& k, real* d) {
-  const GridDims& g = k.g;
-  const index N = g.nodes();
-  for_each_block(g.nz(), g.ny(), double(N) * kDiagonalCost, [&k, &g, d, N](index iz, index iy) {
-    for (index ix = 0; ix < g.nx(); ++ix) {
-      const std::uint8_t cx = k.cls[0][ix], cy = k.cls[1][iy], cz = k.cls[2][iz];
-      const index n = g.node(ix, iy, iz);
+  const StencilView<real> v = view(k);
+  const real* center = k.center.data();
+  const GridDims g = k.g;
+  const index nx = g.nx(), N = g.nodes();
+  for_each_block(g.nz(), g.ny(), double(N) * kDiagonalCost, [=](index iz, index iy) {
+    const std::uint8_t cy = v.cls[1][iy], cz = v.cls[2][iz];
+    for (index ix = 0; ix < nx; ++ix) {
+      const std::uint8_t cx = v.cls[0][ix];
+      const index n = ix + nx * (iy + g.ny() * iz);
       const bool fixed = (cx | cy | cz) & kSelf;
-      const std::int32_t s = fixed ? -1 : k.slot[(cx * 32 + cy) * 32 + cz];
-      for (int a = 0; a < 3; ++a) d[a * N + n] = fixed ? 1 : k.center[3 * s + a];
+      const std::int32_t s = fixed ? -1 : v.slot[(cx * 32 + cy) * 32 + cz];
+      for (int a = 0; a < 3; ++a) d[a * N + n] = fixed ? 1 : center[3 * s + a];
     }
   });
 }
@@ -417,26 +404,25 @@ void elasticity_diagonal_ref(const ElasticityStencil& k, real* d) {
 
 template <class T>
 void zero_constrained(const GridDims& g, unsigned faces, T* v) {
-  // touches only the constrained faces: O(surface), not O(volume)
+  // per node row: all of it on a constrained y or z face, else its ends on
+  // constrained x faces (O(surface) work, one launch)
   const index nx = g.nx(), ny = g.ny(), nz = g.nz(), N = g.nodes();
-  for (int a = 0; a < 3; ++a) {
-    T* c = v + a * N;
-    if (faces & (kFaceZ0 | kFaceZ1))
-      for (index iz : {index(0), nz - 1})
-        if ((iz == 0 && (faces & kFaceZ0)) || (iz == nz - 1 && (faces & kFaceZ1)))
-          for (index n = 0; n < nx * ny; ++n) c[n + nx * ny * iz] = 0;
-    for (index iz = 0; iz < nz; ++iz) {
-      if (faces & kFaceY0)
-        for (index ix = 0; ix < nx; ++ix) c[g.node(ix, 0, iz)] = 0;
-      if (faces & kFaceY1)
-        for (index ix = 0; ix < nx; ++ix) c[g.node(ix, ny - 1, iz)] = 0;
-      if (faces & (kFaceX0 | kFaceX1))
-        for (index iy = 0; iy < ny; ++iy) {
-          if (faces & kFaceX0) c[g.node(0, iy, iz)] = 0;
-          if (faces & kFaceX1) c[g.node(nx - 1, iy, iz)] = 0;
-        }
+  if (!faces) return;
+  const bool x0 = faces & kFaceX0, x1 = faces & kFaceX1;
+  const bool y0 = faces & kFaceY0, y1 = faces & kFaceY1, z0 = faces & kFaceZ0, z1 = faces & kFaceZ1;
+  for_each_block(nz, ny, double(ny) * double(nz) * Cost{48, 0}, [=](index iz, index iy) {
+    const bool whole = (y0 && iy == 0) || (y1 && iy == ny - 1) || (z0 && iz == 0) || (z1 && iz == nz - 1);
+    for (int a = 0; a < 3; ++a) {
+      T* row = v + a * N + nx * (iy + ny * iz);
+      if (whole) {
+#pragma omp simd
+        for (index ix = 0; ix < nx; ++ix) row[ix] = 0;
+        continue;
+      }
+      if (x0) row[0] = 0;
+      if (x1) row[nx - 1] = 0;
     }
-  }
+  });
 }
 
 template void zero_constrained<double>(const GridDims&, unsigned, double*);

@@ -63,6 +63,15 @@ struct ElasticityStencilT {
 
   index nodes() const { return g.nodes(); }
   index size() const { return 3 * g.nodes(); }
+  // its arrays moved to space s (field.hpp)
+  void move_to(Space s) {
+    for (Field<std::uint8_t>& c : cls) c.move_to(s);
+    run_begin.move_to(s);
+    slot.move_to(s);
+    first.move_to(s);
+    groups.move_to(s);
+    center.move_to(s);
+  }
 };
 using ElasticityStencil = ElasticityStencilT<real>;
 using StencilGroup = StencilGroupT<real>;
@@ -102,8 +111,8 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
 void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
                           const real* b = nullptr);
 
-// The arrays an apply reads, as plain pointers: a stencil's own (host_view)
-// or their copies in device memory (DeviceStencil).
+// The arrays an apply reads, as plain pointers into the stencil's Fields
+// (host or device memory: where the stencil lives).
 template <class T>
 struct StencilView {
   GridDims g;
@@ -115,22 +124,7 @@ struct StencilView {
   const StencilGroupT<T>* groups;
 };
 template <class T>
-StencilView<T> host_view(const ElasticityStencilT<T>& k);
-// Copies of a stencil's arrays in device memory (kernels/launch.hpp), freed
-// with it; view() points at them.
-template <class T>
-class DeviceStencil {
- public:
-  explicit DeviceStencil(const ElasticityStencilT<T>& k);
-  ~DeviceStencil();
-  DeviceStencil(const DeviceStencil&) = delete;
-  DeviceStencil& operator=(const DeviceStencil&) = delete;
-  const StencilView<T>& view() const { return v_; }
-
- private:
-  std::vector<void*> blocks_;
-  StencilView<T> v_;
-};
+StencilView<T> view(const ElasticityStencilT<T>& k);
 // The same y = K x (or b - K x) parallel over node rows, one (z, y) row per
 // block with the nodes of its x-runs in `omp simd` lanes: the device's form
 // (a GPU warp per row, its lanes along x: coalesced), run as a target region

@@ -1,8 +1,13 @@
 #include "launch.hpp"
 
 #include <sys/mman.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <map>
 
 #include <cstdlib>
+#include <cstring>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -13,22 +18,6 @@ namespace {
 constexpr std::size_t kHugePage = std::size_t(2) << 20;
 constexpr std::size_t kHugeFrom = std::size_t(1) << 20;
 }  // namespace
-
-void* field_allocate(std::size_t bytes) {
-  if (bytes < kHugeFrom) return ::operator new(bytes);
-  const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
-  void* p = std::aligned_alloc(kHugePage, rounded);
-  if (!p) throw std::bad_alloc();
-  madvise(p, rounded, MADV_HUGEPAGE);  // advice only: where THP is off it fails harmlessly
-  return p;
-}
-
-void field_deallocate(void* p, std::size_t bytes) noexcept {
-  if (bytes < kHugeFrom)
-    ::operator delete(p);
-  else
-    std::free(p);
-}
 
 namespace {
 bool on_device = false;
@@ -51,24 +40,141 @@ void set_launch_on_device(bool on) {
   on_device = on;
 }
 
+namespace {
+// The guard (TRESCA_DEVICE_GUARD=1 where no GPU is present): device memory
+// is mapped PROT_NONE and opened only while a target region or a copy runs,
+// so a host read or write through a device pointer (which the host fallback
+// would otherwise let pass) stops the program with SIGSEGV.
+struct Guard {
+  bool on = false;
+  int open = 0;  // nesting depth of the regions running now
+  std::map<void*, std::size_t> blocks;
+  Guard() {
+    const char* e = std::getenv("TRESCA_DEVICE_GUARD");
+    on = e && std::string(e) == "1" && omp_get_num_devices() == 0;
+  }
+  void protect(int prot) {
+    for (const auto& b : blocks)
+      if (mprotect(b.first, b.second, prot) != 0) throw std::runtime_error("device guard: mprotect failed");
+  }
+};
+Guard& guard() {
+  static Guard g;
+  return g;
+}
+std::size_t page_rounded(std::size_t bytes) {
+  const std::size_t page = std::size_t(sysconf(_SC_PAGESIZE));
+  return std::max<std::size_t>(page, (bytes + page - 1) / page * page);
+}
+
 void* device_allocate(std::size_t bytes) {
+  Guard& g = guard();
+  if (g.on) {
+    const std::size_t size = page_rounded(bytes);
+    void* p = mmap(nullptr, size, g.open ? PROT_READ | PROT_WRITE : PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    g.blocks[p] = size;
+    return p;
+  }
   void* p = omp_target_alloc(bytes, device());
   if (!p && bytes) throw std::bad_alloc();
   return p;
 }
 
-void device_free(void* p) noexcept {
-  if (p) omp_target_free(p, device());
+void device_release(void* p) noexcept {
+  Guard& g = guard();
+  auto it = g.on ? g.blocks.find(p) : g.blocks.end();
+  if (it != g.blocks.end()) {
+    munmap(p, it->second);
+    g.blocks.erase(it);
+    return;
+  }
+  omp_target_free(p, device());
 }
 
-void copy_to_device(void* to, const void* from, std::size_t bytes) {
-  if (omp_target_memcpy(to, from, bytes, 0, 0, device(), omp_get_initial_device()) != 0)
-    throw std::runtime_error("copy to the device failed");
+void* host_allocate(std::size_t bytes) {
+  if (bytes < kHugeFrom) return ::operator new(bytes);
+  const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+  void* p = std::aligned_alloc(kHugePage, rounded);
+  if (!p) throw std::bad_alloc();
+  madvise(p, rounded, MADV_HUGEPAGE);  // advice only: where THP is off it fails harmlessly
+  return p;
 }
 
-void copy_from_device(void* to, const void* from, std::size_t bytes) {
-  if (omp_target_memcpy(to, from, bytes, 0, 0, omp_get_initial_device(), device()) != 0)
-    throw std::runtime_error("copy from the device failed");
+int device_of(Space s) { return s == Space::device ? device() : omp_get_initial_device(); }
+}  // namespace
+
+const char* to_string(Space s) { return s == Space::device ? "device" : "host"; }
+
+Space launch_space() { return on_device ? Space::device : Space::host; }
+
+void* space_allocate(Space s, std::size_t bytes) {
+  return s == Space::device ? device_allocate(bytes) : host_allocate(bytes);
+}
+
+void space_free(Space s, void* p, std::size_t bytes) noexcept {
+  if (!p) return;
+  if (s == Space::device)
+    device_release(p);
+  else if (bytes < kHugeFrom)
+    ::operator delete(p);
+  else
+    std::free(p);
+}
+
+void space_copy(Space to_space, void* to, Space from_space, const void* from, std::size_t bytes) {
+  if (bytes == 0) return;
+  if (to_space == Space::host && from_space == Space::host) {
+    std::memcpy(to, from, bytes);
+    return;
+  }
+  DeviceRegion region;
+  if (omp_target_memcpy(to, from, bytes, 0, 0, device_of(to_space), device_of(from_space)) != 0)
+    throw std::runtime_error(std::string("copying a field from the ") + to_string(from_space) + " to the " +
+                             to_string(to_space) + " failed");
+}
+
+void space_zero(Space s, void* p, std::size_t bytes) {
+  if (bytes == 0) return;
+#ifdef TRESCA_OFFLOAD
+  if (s == Space::device) {
+    DeviceRegion region;
+    unsigned char* q = static_cast<unsigned char*>(p);
+#pragma omp target teams distribute parallel for is_device_ptr(q) device(device())
+    for (std::size_t i = 0; i < bytes; ++i) q[i] = 0;
+    return;
+  }
+#endif
+  std::memset(p, 0, bytes);  // (without offload, "device" memory is the host's)
+}
+
+bool device_guarded() { return guard().on; }
+
+DeviceRegion::DeviceRegion() {
+  Guard& g = guard();
+  if (g.on && g.open++ == 0) g.protect(PROT_READ | PROT_WRITE);
+}
+
+DeviceRegion::~DeviceRegion() {
+  Guard& g = guard();
+  if (g.on && --g.open == 0) g.protect(PROT_NONE);
+}
+
+void field_read_on_host(Space s) {
+  throw std::logic_error(std::string("a Field in ") + to_string(s) +
+                         " memory was read or written on the host (kernels/field.hpp)");
+}
+
+void* device_scratch(std::size_t bytes) {
+  // grown, never shrunk; the process's exit releases it
+  static void* p = nullptr;
+  static std::size_t have = 0;
+  if (bytes > have) {
+    if (p) device_release(p);
+    p = device_allocate(bytes);
+    have = bytes;
+  }
+  return p;
 }
 
 std::string device_description() {

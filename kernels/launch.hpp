@@ -15,10 +15,11 @@
 //     over the same bodies. Nothing above kernels/ names OpenMP's loop
 //     constructs.
 //
-// Field<T> is the storage of everything the linear machinery sweeps: the
-// operators' stencils and diagonals, every multigrid level's vectors, the
-// Krylov vectors. Code that owns such a vector declares it a Field.
+// Field<T> (field.hpp) is the storage of everything the linear machinery
+// sweeps: the operators' stencils and diagonals, every multigrid level's
+// vectors, the Krylov vectors; it lives where the launches run.
 #pragma once
+#include "field.hpp"
 #include "types.hpp"
 
 #include <omp.h>
@@ -29,52 +30,54 @@
 
 namespace tresca {
 
-// Host storage of a Field: large arrays (>= 1 MiB) are aligned to 2 MiB and
-// marked MADV_HUGEPAGE, so where the kernel's transparent-huge-page mode is
-// "madvise" (Debian's default) their first touch costs one page fault per
-// 2 MiB instead of per 4 KiB (perf/RESULTS.md §0d, §0k). Smaller arrays come
-// from operator new as usual.
-void* field_allocate(std::size_t bytes);
-void field_deallocate(void* p, std::size_t bytes) noexcept;
-
-template <class T>
-struct FieldAllocator {
-  using value_type = T;
-  FieldAllocator() = default;
-  template <class U>
-  FieldAllocator(const FieldAllocator<U>&) noexcept {}
-  T* allocate(std::size_t n) { return static_cast<T*>(field_allocate(n * sizeof(T))); }
-  void deallocate(T* p, std::size_t n) noexcept { field_deallocate(p, n * sizeof(T)); }
-  template <class U>
-  bool operator==(const FieldAllocator<U>&) const noexcept { return true; }
-  template <class U>
-  bool operator!=(const FieldAllocator<U>&) const noexcept { return false; }
-};
-
-template <class T>
-using Field = std::vector<T, FieldAllocator<T>>;
-
 // The device backend (a build with TRESCA_OFFLOAD, CMake option of that
 // name: g++-12 with gcc-12-offload-nvptx). While launch_on_device() is
-// true, for_each_entry, sum_over_blocks and the n1 x n0 for_each_block run
-// their bodies as OpenMP target regions on the default device, over
-// pointers that must then be device pointers (device_allocate); without a
-// GPU the target regions run on the host. The 1D for_each_block (the banded
-// CPU apply) and the launcher with scratch (the transfers) have no device
-// branch yet, nor has Field storage: issue 22's next steps. Without
-// TRESCA_OFFLOAD, launch_on_device() is false and set_launch_on_device
-// refuses true.
+// true, every launcher below runs its body as an OpenMP target region on
+// the default device, over the data() of device Fields (field.hpp: new
+// Fields are made there meanwhile); without a GPU the target regions run on
+// the host, through the same code path. Without TRESCA_OFFLOAD,
+// launch_on_device() is false and set_launch_on_device refuses true.
 bool launch_on_device();
 void set_launch_on_device(bool on);  // throws std::invalid_argument if the build has no offload
 bool offload_built();                // whether this build has TRESCA_OFFLOAD
-// device memory of the default device (omp_target_alloc; the host's when
-// there is none), and copies to and from it
-void* device_allocate(std::size_t bytes);
-void device_free(void* p) noexcept;
-void copy_to_device(void* device, const void* host, std::size_t bytes);
-void copy_from_device(void* host, const void* device, std::size_t bytes);
 // "device 0 of 1 (OpenMP offload)", or "none: target regions run on the host"
 std::string device_description();
+
+// Launches run on the host inside this scope (setup code that fills Fields
+// entry by entry; its owner then moves them: field.hpp), and where they ran
+// before after it.
+class HostLaunches {
+ public:
+  HostLaunches() : was_(launch_on_device()) { set_launch_on_device(false); }
+  ~HostLaunches() { set_launch_on_device(was_); }
+  HostLaunches(const HostLaunches&) = delete;
+  HostLaunches& operator=(const HostLaunches&) = delete;
+  // where the launches ran before: where what the scope builds belongs
+  Space space_before() const { return was_ ? Space::device : Space::host; }
+
+ private:
+  bool was_;
+};
+
+// Every device launch and copy runs inside a DeviceRegion: where no GPU is
+// present and TRESCA_DEVICE_GUARD=1, device memory is open to the host
+// only meanwhile (the tests' check that a device solve never reads device
+// memory on the host); otherwise it costs nothing.
+class DeviceRegion {
+ public:
+  DeviceRegion();
+  ~DeviceRegion();
+  DeviceRegion(const DeviceRegion&) = delete;
+  DeviceRegion& operator=(const DeviceRegion&) = delete;
+};
+bool device_guarded();  // whether that guard is on
+
+// scratch for a device launch: `bytes` of device memory, kept and reused
+// from launch to launch (one launch at a time)
+void* device_scratch(std::size_t bytes);
+// the blocks' scratch on the device: kScratchTeams x kScratchThreads
+// workers, each with its own slice
+constexpr int kScratchTeams = 1024, kScratchThreads = 8;
 
 // How many workers a launch has (threads on the host): a kernel that cuts
 // its range into cache-sized blocks makes at least one block per worker.
@@ -88,6 +91,7 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
     // a copy of the body, mapped implicitly: its captures (device pointers,
     // scalars) travel by value (GCC 12 fails on a lambda in a map or
     // firstprivate clause: an internal compiler error)
+    DeviceRegion region;
     Body b = body;
 #pragma omp target teams distribute parallel for simd
     for (index i = 0; i < n; ++i) b(i);
@@ -103,6 +107,15 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
 // whole launch's modelled cost.
 template <class Body>
 inline void for_each_block(index n, Cost work, const Body& body) {
+#ifdef TRESCA_OFFLOAD
+  if (launch_on_device()) {
+    DeviceRegion region;
+    Body b = body;
+#pragma omp target teams distribute parallel for
+    for (index i = 0; i < n; ++i) b(i);
+    return;
+  }
+#endif
 #pragma omp parallel for schedule(static) if (worth_threads(work))
   for (index b = 0; b < n; ++b) body(b);
 }
@@ -112,6 +125,7 @@ template <class Body>
 inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {  // one block per (team) thread; the body's own `omp simd` loops in its lanes
+    DeviceRegion region;
     Body b = body;
 #pragma omp target teams distribute parallel for collapse(2)
     for (index j = 0; j < n1; ++j)
@@ -128,6 +142,18 @@ inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
 // launch (allocated once per launch, not per block): body(j, i, scratch).
 template <class T, class Body>
 inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost work, const Body& body) {
+#ifdef TRESCA_OFFLOAD
+  if (launch_on_device()) {  // each (team, thread) its slice of one scratch buffer
+    T* pool = static_cast<T*>(device_scratch(std::size_t(kScratchTeams) * kScratchThreads * scratch * sizeof(T)));
+    DeviceRegion region;
+    Body b = body;
+#pragma omp target teams distribute parallel for collapse(2) num_teams(kScratchTeams) thread_limit(kScratchThreads) is_device_ptr(pool)
+    for (index j = 0; j < n1; ++j)
+      for (index i = 0; i < n0; ++i)
+        b(j, i, pool + (index(omp_get_team_num()) * kScratchThreads + omp_get_thread_num()) * scratch);
+    return;
+  }
+#endif
 #pragma omp parallel if (worth_threads(work))
   {
     std::vector<T> buffer(scratch);
@@ -155,6 +181,7 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
   }
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
+    DeviceRegion region;
     Block bl = block;
 #pragma omp target teams distribute parallel for map(from : part[0 : nb])
     for (index b = 0; b < nb; ++b) part[b] = bl(b * width, b + 1 < nb ? (b + 1) * width : n);

@@ -39,20 +39,33 @@ Interp1D build_axis(index ef, index ec) {
   return a;
 }
 
+// an axis's arrays as plain pointers (captured by value in the launches)
+struct AxisView {
+  const index *j0, *tstart, *tf;
+  const real *w, *tw;
+  explicit AxisView(const Interp1D& a)
+      : j0(a.j0.data()), tstart(a.tstart.data()), tf(a.tf.data()), w(a.w.data()), tw(a.tw.data()) {}
+};
+
 }  // namespace
 
 Transfer build_transfer(const GridDims& fine, const GridDims& coarse) {
+  HostLaunches host;
   Transfer t;
   t.fine = fine;
   t.coarse = coarse;
   t.axis[0] = build_axis(fine.ex, coarse.ex);
   t.axis[1] = build_axis(fine.ey, coarse.ey);
   t.axis[2] = build_axis(fine.ez, coarse.ez);
+  t.move_to(host.space_before());
   return t;
 }
 
-Transfer slice_rows(const Transfer& t, index f0, index f1, index c0, index c1) {
-  TRESCA_ASSERT(0 <= f0 && f0 + 2 <= f1 && f1 <= t.fine.ny() && 0 <= c0 && c0 + 2 <= c1 && c1 <= t.coarse.ny());
+Transfer slice_rows(const Transfer& whole, index f0, index f1, index c0, index c1) {
+  TRESCA_ASSERT(0 <= f0 && f0 + 2 <= f1 && f1 <= whole.fine.ny() && 0 <= c0 && c0 + 2 <= c1 && c1 <= whole.coarse.ny());
+  HostLaunches host;
+  Transfer t = whole;
+  t.move_to(Space::host);
   Transfer s = t;
   s.fine = rows_box(t.fine, f0, f1);
   s.coarse = rows_box(t.coarse, c0, c1);
@@ -73,6 +86,7 @@ Transfer slice_rows(const Transfer& t, index f0, index f1, index c0, index c1) {
     y.tstart.push_back(index(y.tf.size()));
   }
   s.axis[1] = std::move(y);
+  s.move_to(host.space_before());
   return s;
 }
 
@@ -85,9 +99,10 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
   // 2 per fine node, instead of 8 coarse reads per fine node.
   const GridDims &f = t.fine, &c = t.coarse;
   const index Nf = f.nodes(), Nc = c.nodes(), cnx = c.nx(), cny = c.ny(), fnx = f.nx();
-  const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
+  const index fny = f.ny();
+  const AxisView X(t.axis[0]), Y(t.axis[1]), Z(t.axis[2]);
   // one fine row (iy, iz); s: a coarse row of the worker's own
-  const auto fine_row = [&](index iz, index iy, T* s) {
+  const auto fine_row = [=](index iz, index iy, T* s) {
     const index jz = Z.j0[iz], jy = Y.j0[iy];
     const T wz = T(Z.w[iz]), wy = T(Y.w[iy]);
     const T w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
@@ -96,7 +111,7 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
       const T* u = coarse + a * Nc;
 #pragma omp simd
       for (index j = 0; j < cnx; ++j) s[j] = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
-      T* v = fine + a * Nf + fnx * (iy + f.ny() * iz);
+      T* v = fine + a * Nf + fnx * (iy + fny * iz);
       for (index ix = 0; ix < fnx; ++ix) {
         const index j = X.j0[ix];
         const T wx = T(X.w[ix]);
@@ -138,20 +153,21 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) 
   // into one row buffer (contiguous, vectorisable), then gather along x.
   const GridDims &f = t.fine, &c = t.coarse;
   const index Nf = f.nodes(), Nc = c.nodes(), fnx = f.nx();
-  const Interp1D &X = t.axis[0], &Y = t.axis[1], &Z = t.axis[2];
+  const index fny = f.ny(), cnx = c.nx(), cny = c.ny();
+  const AxisView X(t.axis[0]), Y(t.axis[1]), Z(t.axis[2]);
   // one coarse row (jy, jz); acc: a fine row of the worker's own
-  const auto coarse_row = [&](index jz, index jy, T* acc) {
+  const auto coarse_row = [=](index jz, index jy, T* acc) {
     for (int a = 0; a < comps; ++a) {
       for (index i = 0; i < fnx; ++i) acc[i] = 0;
       for (index kz = Z.tstart[jz]; kz < Z.tstart[jz + 1]; ++kz)
         for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky) {
           const T w = T(Z.tw[kz] * Y.tw[ky]);
-          const T* rr = fine + a * Nf + fnx * (Y.tf[ky] + f.ny() * Z.tf[kz]);
+          const T* rr = fine + a * Nf + fnx * (Y.tf[ky] + fny * Z.tf[kz]);
 #pragma omp simd
           for (index i = 0; i < fnx; ++i) acc[i] += w * rr[i];
         }
-      T* out = coarse + a * Nc + c.nx() * (jy + c.ny() * jz);
-      for (index jx = 0; jx < c.nx(); ++jx) {
+      T* out = coarse + a * Nc + cnx * (jy + cny * jz);
+      for (index jx = 0; jx < cnx; ++jx) {
         T sx = 0;
         for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += T(X.tw[kx]) * acc[X.tf[kx]];
         out[jx] = sx;

@@ -38,13 +38,25 @@ struct Interp1D {
   // transpose lists: coarse j receives from fine tf[tstart[j]..tstart[j+1]) with weights tw
   Field<index> tstart, tf;
   Field<real> tw;
+  void move_to(Space s) {
+    j0.move_to(s);
+    w.move_to(s);
+    tstart.move_to(s);
+    tf.move_to(s);
+    tw.move_to(s);
+  }
 };
 
 struct Transfer {
   GridDims fine, coarse;
   Interp1D axis[3];
+  // its arrays moved to space s (field.hpp)
+  void move_to(Space s) {
+    for (Interp1D& a : axis) a.move_to(s);
+  }
 };
 
+// built in the space where launches run (field.hpp)
 Transfer build_transfer(const GridDims& fine, const GridDims& coarse);
 
 // The part of t between fine rows [f0, f1) and coarse rows [c0, c1) (y

@@ -100,6 +100,11 @@ void convert(index n, const From* x, To* y) {
   for_each_entry(n, Cost{double(sizeof(From) + sizeof(To)), 0}, [=](index i) { y[i] = To(x[i]); });
 }
 
+template <class To>
+void reciprocal_or_zero(index n, const real* x, To* y) {
+  for_each_entry(n, Cost{double(sizeof(real) + sizeof(To)), 1}, [=](index i) { y[i] = x[i] != 0 ? To(1 / x[i]) : To(0); });
+}
+
 template <class T>
 void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x) {
   for_each_entry(n, in_precision<T>(kChebUpdateCost), [=](index i) {
@@ -115,6 +120,8 @@ void cheb_first(index n, T t, const T* dinv, const T* b, T* d, T* x) {
 
 template void fill<double>(index, double, double*);
 template void fill<float>(index, float, float*);
+template void reciprocal_or_zero<double>(index, const real*, double*);
+template void reciprocal_or_zero<float>(index, const real*, float*);
 template void convert<float, double>(index, const double*, float*);
 template void convert<double, float>(index, const float*, double*);
 template void cheb_update<double>(index, double, double, const double*, const double*, double*, double*);

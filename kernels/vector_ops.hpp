@@ -32,6 +32,9 @@ template <class To, class From>
 void convert(index n, const From* x, To* y);               // y = To(x) (double <-> float)
 void scale(index n, real a, real* y);                      // y *= a
 void hadamard(index n, const real* d, const real* x, real* y);  // y = d .* x
+// y = 1 / x where x != 0, else 0 (Jacobi's inverse diagonal; To = double, float)
+template <class To>
+void reciprocal_or_zero(index n, const real* x, To* y);
 // x += a p; r -= a q; returns r.r
 real cg_update(index n, real a, const real* p, const real* q, real* x, real* r);
 real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real* r);

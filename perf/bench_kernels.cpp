@@ -37,131 +37,130 @@ void set_rates(benchmark::State& st, double dofs, double bytes_per_dof, double f
   st.counters["dofs"] = dofs;
 }
 
-// T: double, float (the single-precision V-cycle's apply); kRef: the serial _ref twin (double)
-template <class T, bool kRef>
+// Where a benchmark runs: the host's kernels, the serial _ref twin, or the
+// device backend (kernels/launch.hpp: a TRESCA_OFFLOAD build; every Field
+// made in the benchmark then lives in device memory, and the timed loop is
+// the kernels alone, no copies; on the host where there is no GPU: the
+// context header's "device" says which).
+enum class Run { host, ref, device };
+
+// launches on the device for a Run::device benchmark's life; false (and the
+// benchmark skipped with the reason) where the build has no device backend
+bool run_where(benchmark::State& st, Run run) {
+  if (run != Run::device) return true;
+  if (!offload_built()) {
+    st.SkipWithError("built without TRESCA_OFFLOAD (no device backend)");
+    return false;
+  }
+  set_launch_on_device(true);
+  return true;
+}
+void done(Run run) {
+  if (run == Run::device) set_launch_on_device(false);
+}
+
+// host values in a Field where launches run
+template <class T>
+Field<T> field_of(const std::vector<real>& h) {
+  Field<T> f(h.begin(), h.end());
+  f.move_to(launch_space());
+  return f;
+}
+
+// T: double, float (the single-precision V-cycle's apply); Run::ref: the serial _ref twin (double)
+template <class T, Run kRun>
 void BM_Apply(benchmark::State& st) {
   const Problem P = make_problem(spec_for_level(int(st.range(0))));
-  const ElasticityStencil k = build_elasticity_stencil(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
-  const ElasticityStencilT<T> kt = stencil_in_precision<T>(k);
-  const auto xd = ramp(k.size());
-  std::vector<T> x(xd.begin(), xd.end()), y(k.size());
-  for (auto _ : st) {
-    if constexpr (kRef)
-      elasticity_apply_ref(k, x.data(), y.data(), 0, P.grid.nz());
-    else
-      elasticity_apply<T>(kt, x.data(), y.data(), 0, P.grid.nz());
-    benchmark::DoNotOptimize(y.data());
-    benchmark::ClobberMemory();
+  if (!run_where(st, kRun)) return;
+  {
+    const ElasticityStencil k = build_elasticity_stencil(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+    const ElasticityStencilT<T> kt = stencil_in_precision<T>(k);
+    Field<T> x = field_of<T>(ramp(k.size())), y(k.size());
+    for (auto _ : st) {
+      if constexpr (kRun == Run::ref)
+        elasticity_apply_ref(k, x.data(), y.data(), 0, P.grid.nz());
+      else
+        elasticity_apply<T>(kt, x.data(), y.data(), 0, P.grid.nz());
+      benchmark::DoNotOptimize(y.data());
+      benchmark::ClobberMemory();
+    }
   }
+  done(kRun);
   const Cost c = in_precision<T>(kApplyCost);
-  set_rates(st, double(k.size()), c.bytes / 3, c.flops / 3);
+  set_rates(st, double(P.dofs()), c.bytes / 3, c.flops / 3);
 }
-BENCHMARK_TEMPLATE(BM_Apply, double, false)->Name("Apply")->DenseRange(6, 12, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_Apply, float, false)->Name("ApplyFloat")->DenseRange(6, 12, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_Apply, double, true)->Name("ApplyRef")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Apply, double, Run::host)->Name("Apply")->DenseRange(6, 12, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Apply, float, Run::host)->Name("ApplyFloat")->DenseRange(6, 12, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Apply, double, Run::ref)->Name("ApplyRef")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Apply, double, Run::device)->Name("DeviceApply")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Apply, float, Run::device)->Name("DeviceApplyFloat")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
 
+template <Run kRun>
 void BM_VCycle(benchmark::State& st) {
   const Problem P = make_problem(spec_for_level(int(st.range(0))));
-  Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
-  auto r = ramp(P.dofs());
-  zero_constrained(P.grid, P.interior_faces, r.data());
-  std::vector<real> z(P.dofs());
-  for (auto _ : st) {
-    mg.apply(r.data(), z.data());
-    benchmark::DoNotOptimize(z.data());
+  auto h = ramp(P.dofs());
+  zero_constrained(P.grid, P.interior_faces, h.data());
+  if (!run_where(st, kRun)) return;
+  {
+    Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+    Field<real> r = field_of<real>(h), z(P.dofs());
+    for (auto _ : st) {
+      mg.apply(r.data(), z.data());
+      benchmark::DoNotOptimize(z.data());
+    }
   }
+  done(kRun);
   set_rates(st, double(P.dofs()), 0, 0);
 }
-BENCHMARK(BM_VCycle)->Name("VCycle")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_VCycle, Run::host)->Name("VCycle")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_VCycle, Run::device)->Name("DeviceVCycle")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
 
+template <Run kRun>
 void BM_Transfer(benchmark::State& st) {
   const Problem P = make_problem(spec_for_level(int(st.range(0))));
   GridDims c = P.grid;
   c.ex = (c.ex + 1) / 2;
   c.ey = (c.ey + 1) / 2;
   c.ez = (c.ez + 1) / 2;
-  const Transfer t = build_transfer(P.grid, c);
-  auto f = ramp(3 * P.grid.nodes());
-  std::vector<real> cc(3 * c.nodes());
-  for (auto _ : st) {
-    restrict_to_coarse(t, 3, f.data(), cc.data());
-    prolongate(t, 3, cc.data(), f.data());
-    benchmark::DoNotOptimize(f.data());
+  if (!run_where(st, kRun)) return;
+  {
+    const Transfer t = build_transfer(P.grid, c);
+    Field<real> f = field_of<real>(ramp(3 * P.grid.nodes())), cc(3 * c.nodes());
+    for (auto _ : st) {
+      restrict_to_coarse(t, 3, f.data(), cc.data());
+      prolongate(t, 3, cc.data(), f.data());
+      benchmark::DoNotOptimize(f.data());
+    }
   }
+  done(kRun);
   const Cost cost = kRestrictCost + kProlongateCost;
   set_rates(st, double(3 * P.grid.nodes()), cost.bytes, cost.flops);
 }
-BENCHMARK(BM_Transfer)->Name("RestrictProlong")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Transfer, Run::host)->Name("RestrictProlong")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Transfer, Run::device)->Name("DeviceRestrictProlong")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
 
-void BM_Dot(benchmark::State& st) {
-  const index n = index(st.range(0));
-  auto x = ramp(n), y = ramp(n);
-  for (auto _ : st) benchmark::DoNotOptimize(dot(n, x.data(), y.data()));
-  set_rates(st, double(n), kDotCost.bytes, kDotCost.flops);
-}
-BENCHMARK(BM_Dot)->Name("Dot")->Arg(1 << 20)->Arg(1 << 24)->UseRealTime();
-
-// The same vector kernels through the device backend (kernels/launch.hpp):
-// their vectors in device memory, launched as target regions (a
-// TRESCA_OFFLOAD build; on the host where there is no GPU, "device" in the
-// context header says which). The timed loop is the kernel alone: no copies.
-template <int kKernel>  // 0: dot, 1: axpy, 2: cg_update
-void BM_Device(benchmark::State& st) {
-  if (!offload_built()) {
-    st.SkipWithError("built without TRESCA_OFFLOAD (no device backend)");
-    return;
-  }
+// the vector kernels: 0 dot, 1 axpy, 2 cg_update
+template <int kKernel, Run kRun>
+void BM_Vector(benchmark::State& st) {
   const index n = index(st.range(0));
   const std::vector<real> h = ramp(n);
-  const std::size_t bytes = std::size_t(n) * sizeof(real);
-  real* v[4];
-  for (real*& p : v) {
-    p = static_cast<real*>(device_allocate(bytes));
-    copy_to_device(p, h.data(), bytes);
+  if (!run_where(st, kRun)) return;
+  {
+    Field<real> v[4] = {field_of<real>(h), field_of<real>(h), field_of<real>(h), field_of<real>(h)};
+    for (auto _ : st) {
+      if (kKernel == 0) benchmark::DoNotOptimize(dot(n, v[0].data(), v[1].data()));
+      if (kKernel == 1) axpy(n, 1e-9, v[0].data(), v[1].data());
+      if (kKernel == 2) benchmark::DoNotOptimize(cg_update(n, 1e-9, v[0].data(), v[1].data(), v[2].data(), v[3].data()));
+    }
   }
-  set_launch_on_device(true);
-  for (auto _ : st) {
-    if (kKernel == 0) benchmark::DoNotOptimize(dot(n, v[0], v[1]));
-    if (kKernel == 1) axpy(n, 1e-9, v[0], v[1]);
-    if (kKernel == 2) benchmark::DoNotOptimize(cg_update(n, 1e-9, v[0], v[1], v[2], v[3]));
-  }
-  set_launch_on_device(false);
-  for (real* p : v) device_free(p);
+  done(kRun);
   const Cost c = kKernel == 0 ? kDotCost : kKernel == 1 ? kAxpyCost : kCgUpdateCost;
   set_rates(st, double(n), c.bytes, c.flops);
 }
-// The stencil apply on the device (its row form, elasticity_apply_rows),
-// stencil and vectors in device memory; T = double, float
-template <class T>
-void BM_DeviceApply(benchmark::State& st) {
-  if (!offload_built()) {
-    st.SkipWithError("built without TRESCA_OFFLOAD (no device backend)");
-    return;
-  }
-  const Problem P = make_problem(spec_for_level(int(st.range(0))));
-  const ElasticityStencil k64 = build_elasticity_stencil(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
-  const ElasticityStencilT<T> k = stencil_in_precision<T>(k64);
-  const index n = k.size();
-  const std::vector<real> h = ramp(n);
-  const std::vector<T> ht(h.begin(), h.end());
-  const DeviceStencil<T> dk(k);
-  T* x = static_cast<T*>(device_allocate(n * sizeof(T)));
-  T* y = static_cast<T*>(device_allocate(n * sizeof(T)));
-  copy_to_device(x, ht.data(), n * sizeof(T));
-  const RowBlock all{0, P.grid.nz(), 0, P.grid.ny()};
-  set_launch_on_device(true);
-  for (auto _ : st) elasticity_apply_rows(dk.view(), x, y, all);
-  set_launch_on_device(false);
-  device_free(x);
-  device_free(y);
-  set_rates(st, double(n), in_precision<T>(kApplyCost).bytes / 3, kApplyCost.flops / 3);
-}
-BENCHMARK_TEMPLATE(BM_DeviceApply, double)->Name("DeviceApply")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_DeviceApply, float)->Name("DeviceApplyFloat")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
-
-BENCHMARK_TEMPLATE(BM_Device, 0)->Name("DeviceDot")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
-BENCHMARK_TEMPLATE(BM_Device, 1)->Name("DeviceAxpy")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
-BENCHMARK_TEMPLATE(BM_Device, 2)->Name("DeviceCgUpdate")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_Vector, 0, Run::host)->Name("Dot")->Arg(1 << 20)->Arg(1 << 24)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_Vector, 0, Run::device)->Name("DeviceDot")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_Vector, 1, Run::device)->Name("DeviceAxpy")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
+BENCHMARK_TEMPLATE(BM_Vector, 2, Run::device)->Name("DeviceCgUpdate")->Arg(1 << 24)->Arg(1 << 27)->UseRealTime();
 
 }  // namespace
 }  // namespace tresca
@@ -171,9 +170,10 @@ static const char* kHelp =
     "The kernels one by one on the fields of mesh levels 6-12 (Apply, ApplyFloat, ApplyRef: the\n"
     "serial _ref twin, VCycle, RestrictProlong, Dot), each with the counters DoF/s, bytes/s and\n"
     "FLOP/s from the kernels' cost models, omp_threads and dofs; the build (ISA, vector width,\n"
-    "compiler) and the offload device are in the context header. DeviceDot, DeviceAxpy and\n"
-    "DeviceCgUpdate: the vector kernels in device memory through the offload backend\n"
-    "(a -DTRESCA_OFFLOAD=ON build; otherwise they are skipped with that message).\n"
+    "compiler) and the offload device are in the context header. Device*: the same kernels\n"
+    "(DeviceApply, DeviceApplyFloat, DeviceVCycle, DeviceRestrictProlong, DeviceDot, DeviceAxpy,\n"
+    "DeviceCgUpdate) with every field in device memory, through the offload backend (a\n"
+    "-DTRESCA_OFFLOAD=ON build; otherwise they are skipped with that message).\n"
     "  --benchmark_filter=REGEX        which ones, e.g. 'Apply/10|VCycle/10'\n"
     "  --benchmark_repetitions=N       repeat each; with --benchmark_report_aggregates_only=true\n"
     "                                  only the mean, median, stddev and cv are printed\n"

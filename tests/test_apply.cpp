@@ -87,13 +87,13 @@ TEST(ElasticityApply, RowFormEqualsTheBandedApply) {
         for (const real* bb : {(const real*)nullptr, b.data()}) {
           std::vector<real> y(k.size(), 7.0), yr(k.size(), 7.0);
           elasticity_apply(k, x.data(), y.data(), rows, bb);
-          elasticity_apply_rows(host_view(k), x.data(), yr.data(), rows, bb);
+          elasticity_apply_rows(view(k), x.data(), yr.data(), rows, bb);
           EXPECT_LE(max_abs_diff(y, yr), 1e-14 * max_abs(y)) << s[0] << "x" << s[1] << "x" << s[2] << " faces " << faces;
         }
       const auto kf = stencil_in_precision<float>(k);
       std::vector<float> xf(x.begin(), x.end()), yf(k.size()), yfr(k.size());
       elasticity_apply(kf, xf.data(), yf.data(), RowBlock{0, g.nz(), 0, g.ny()});
-      elasticity_apply_rows(host_view(kf), xf.data(), yfr.data(), RowBlock{0, g.nz(), 0, g.ny()});
+      elasticity_apply_rows(view(kf), xf.data(), yfr.data(), RowBlock{0, g.nz(), 0, g.ny()});
       float m = 0, d = 0;
       for (size_t i = 0; i < yf.size(); ++i) {
         m = std::max(m, std::abs(yf[i]));
@@ -212,7 +212,7 @@ TEST(BottomBlock, OptimisedEqualsReferenceAndAssembly) {
   ElasticityOperator A(g, kFaceX0, 1.0, 0.3);
   const index M = g.nx() * g.ny();
   const std::vector<real> B = random_vector(4 * M, 21);
-  A.set_bottom_block(Field<real>(B.begin(), B.end()));
+  A.set_bottom_block(B);
   auto x = random_vector(A.size(), 22);
   std::vector<real> y(A.size(), 0), yr(A.size(), 0);
   bottom_block_apply(g, 0.5, A.bottom_block().data(), x.data(), y.data());

@@ -12,9 +12,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
+#include "core/fem/problem.hpp"
+#include "core/multigrid/interior.hpp"
+#include "core/multigrid/multigrid.hpp"
 #include "kernels/elasticity.hpp"
+#include "kernels/transfer.hpp"
 #include "kernels/launch.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"
@@ -22,25 +27,15 @@
 namespace tresca {
 
 namespace {
-// a device copy of a host vector, freed at scope exit
-struct DeviceVector {
-  index n;
-  real* p;
-  explicit DeviceVector(const std::vector<real>& host)
-      : n(index(host.size())), p(static_cast<real*>(device_allocate(host.size() * sizeof(real)))) {
-    copy_to_device(p, host.data(), host.size() * sizeof(real));
-  }
-  ~DeviceVector() { device_free(p); }
-  DeviceVector(const DeviceVector&) = delete;
-  DeviceVector& operator=(const DeviceVector&) = delete;
-  std::vector<real> host() const {
-    std::vector<real> h(n);
-    copy_from_device(h.data(), p, h.size() * sizeof(real));
-    return h;
-  }
-};
+// host values in a Field on the device (kernels/field.hpp)
+template <class T = real>
+Field<T> on_device(const std::vector<real>& host) {
+  Field<T> f(host.begin(), host.end());
+  f.move_to(Space::device);
+  return f;
+}
 
-// launches go to the device inside this scope
+// launches (and the Fields they make) go to the device inside this scope
 struct OnDevice {
   OnDevice() { set_launch_on_device(true); }
   ~OnDevice() { set_launch_on_device(false); }
@@ -63,6 +58,51 @@ TEST(Device, WithoutOffloadTheDeviceIsRefused) {
   EXPECT_FALSE(launch_on_device());
 }
 
+// where a Field lives, in any build (without offload, "device" memory is
+// the host's, through the same calls)
+TEST(Field, LivesWhereItIsMadeAndMovesOnRequest) {
+  Field<real> h{1, 2, 3};
+  EXPECT_EQ(h.space(), Space::host);
+  EXPECT_EQ(Field<real>(4).space(), launch_space());
+  Field<real> d = h;
+  d.move_to(Space::device);
+  EXPECT_TRUE(d.on_device());
+  EXPECT_THROW(d[0], std::logic_error) << "a device Field read on the host";
+  EXPECT_THROW(d.begin(), std::logic_error);
+  EXPECT_THROW(d.push_back(4), std::logic_error);
+  d.resize(5);  // kept entries and zero new ones, on the device
+  EXPECT_TRUE(d.on_device());
+  EXPECT_EQ(d.to_vector(), (std::vector<real>{1, 2, 3, 0, 0}));
+  const Field<real> c = d;  // a copy lives where its source does
+  EXPECT_TRUE(c.on_device());
+  EXPECT_EQ(c.to_vector(), d.to_vector());
+  d.move_to(Space::host);
+  EXPECT_EQ(d.space(), Space::host);
+  EXPECT_EQ(d[4], 0);
+  EXPECT_EQ(d[2], 3);
+  Field<real> e;  // an empty Field has no place until it gets storage
+  e.push_back(7);
+  EXPECT_EQ(e.space(), Space::host);
+  EXPECT_EQ(e.size(), 1u);
+}
+
+// the guard that the device.guarded run relies on: a host read through a
+// device pointer stops the program
+TEST(DeviceGuard, StopsAHostReadOfDeviceMemory) {
+  const char* e = std::getenv("TRESCA_DEVICE_GUARD");
+  if (!e || std::string(e) != "1") GTEST_SKIP() << "TRESCA_DEVICE_GUARD unset";
+  if (omp_get_num_devices() > 0) GTEST_SKIP() << "a GPU is present: its memory guards itself";
+  ASSERT_TRUE(device_guarded());
+  const Field<real> d = on_device({1, 2, 3});
+  EXPECT_EQ(d.to_vector()[1], 2);  // through a copy: allowed
+  EXPECT_DEATH(
+      {
+        volatile real v = d.data()[1];
+        (void)v;
+      },
+      "");
+}
+
 TEST(Device, VectorKernelsOnTheDeviceMatchTheHost) {
   if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
   std::printf("device: %s\n", device_description().c_str());
@@ -75,25 +115,27 @@ TEST(Device, VectorKernelsOnTheDeviceMatchTheHost) {
     const real hd = dot(n, x.data(), y.data());
     const real hrr = cg_update(n, 0.37, x.data(), y.data(), hx.data(), hr.data());
     // the device's
-    DeviceVector dx(x), dy(y), dq(y), dr(r), dx2(x);
+    Field<real> dx = on_device(x), dy = on_device(y), dq = on_device(y), dr = on_device(r), dx2 = on_device(x);
     real dd = 0, drr = 0;
     {
       OnDevice on;
-      axpy(n, 0.5, dx.p, dy.p);
-      xpay(n, dx.p, -0.25, dy.p);
-      dd = dot(n, dx.p, dq.p);
-      drr = cg_update(n, 0.37, dx.p, dq.p, dx2.p, dr.p);
+      axpy(n, 0.5, dx.data(), dy.data());
+      xpay(n, dx.data(), -0.25, dy.data());
+      dd = dot(n, dx.data(), dq.data());
+      drr = cg_update(n, 0.37, dx.data(), dq.data(), dx2.data(), dr.data());
     }
-    EXPECT_LE(test::max_abs_diff(dy.host(), hy), 1e-15 * std::max(real(1), test::max_abs(hy))) << "axpy/xpay, n = " << n;
+    EXPECT_LE(test::max_abs_diff(dy.to_vector(), hy), 1e-15 * std::max(real(1), test::max_abs(hy)))
+        << "axpy/xpay, n = " << n;
     EXPECT_NEAR(dd, hd, 1e-13 * std::max(real(1), std::abs(hd))) << "dot, n = " << n;
     EXPECT_NEAR(drr, hrr, 1e-13 * hrr) << "cg_update, n = " << n;
-    EXPECT_LT(test::max_abs_diff(dx2.host(), hx), 1e-15) << "cg_update x, n = " << n;
-    EXPECT_LT(test::max_abs_diff(dr.host(), hr), 1e-15) << "cg_update r, n = " << n;
+    EXPECT_LT(test::max_abs_diff(dx2.to_vector(), hx), 1e-15) << "cg_update x, n = " << n;
+    EXPECT_LT(test::max_abs_diff(dr.to_vector(), hr), 1e-15) << "cg_update r, n = " << n;
   }
 }
 
-// the stencil apply in its row form, stencil and vectors in device memory,
-// against the banded apply on the host, plain and fused, double and float
+// the stencil apply (its row form on the device), stencil and vectors made
+// with the launches on the device, against the banded apply on the host,
+// plain and fused, double and float
 TEST(Device, StencilApplyOnTheDeviceMatchesTheHost) {
   if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
   for (unsigned faces : {0u, unsigned(kFaceX0 | kFaceZ0)}) {
@@ -104,16 +146,96 @@ TEST(Device, StencilApplyOnTheDeviceMatchesTheHost) {
     std::vector<real> hy(k.size()), hr(k.size());
     elasticity_apply(k, x.data(), hy.data(), all);
     elasticity_apply(k, x.data(), hr.data(), all, b.data());
-    const DeviceStencil<real> dk(k);
-    DeviceVector dx(x), db(b), dy(std::vector<real>(k.size(), 7.0)), dr(std::vector<real>(k.size(), 7.0));
+    const ElasticityStencilT<float> kf = stencil_in_precision<float>(k);
+    std::vector<float> xf(x.begin(), x.end()), hyf(k.size());
+    elasticity_apply(kf, xf.data(), hyf.data(), all);
+    Field<real> dy, dr;
+    Field<float> dyf;
     {
       OnDevice on;
-      elasticity_apply_rows(dk.view(), dx.p, dy.p, all);
-      elasticity_apply_rows(dk.view(), dx.p, dr.p, all, db.p);
+      const ElasticityStencil dk = build_elasticity_stencil(g, faces, 1.0, 0.3);
+      const ElasticityStencilT<float> dkf = stencil_in_precision<float>(dk);
+      ASSERT_TRUE(dk.groups.on_device() && dkf.groups.on_device());
+      Field<real> dx = on_device(x), db = on_device(b);
+      Field<float> dxf = on_device<float>(x);
+      dy.resize(k.size());
+      dr.resize(k.size());
+      dyf.resize(k.size());
+      elasticity_apply(dk, dx.data(), dy.data(), all);
+      elasticity_apply(dk, dx.data(), dr.data(), all, db.data());
+      elasticity_apply(dkf, dxf.data(), dyf.data(), all);
     }
-    EXPECT_LE(test::max_abs_diff(dy.host(), hy), 1e-14 * test::max_abs(hy)) << "faces " << faces;
-    EXPECT_LE(test::max_abs_diff(dr.host(), hr), 1e-14 * test::max_abs(hr)) << "faces " << faces;
+    EXPECT_LE(test::max_abs_diff(dy.to_vector(), hy), 1e-14 * test::max_abs(hy)) << "faces " << faces;
+    EXPECT_LE(test::max_abs_diff(dr.to_vector(), hr), 1e-14 * test::max_abs(hr)) << "faces " << faces;
+    const std::vector<float> yf = dyf.to_vector();
+    EXPECT_LE(test::max_abs_diff(std::vector<real>(yf.begin(), yf.end()), std::vector<real>(hyf.begin(), hyf.end())),
+              1e-5 * test::max_abs(hy))
+        << "float, faces " << faces;
   }
+}
+
+// restriction and (accumulating) prolongation on the device against the host
+TEST(Device, TransfersOnTheDeviceMatchTheHost) {
+  if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
+  const GridDims f = test::prism(13, 7, 9), c = test::prism(7, 4, 5);
+  const Transfer t = build_transfer(f, c);
+  const auto xf = test::random_vector(3 * f.nodes(), 4), xc = test::random_vector(3 * c.nodes(), 5);
+  std::vector<real> hc(3 * c.nodes()), hf = xf;
+  restrict_to_coarse(t, 3, xf.data(), hc.data());
+  prolongate(t, 3, xc.data(), hf.data(), true);
+  Field<real> dc, df = on_device(xf);
+  {
+    OnDevice on;
+    const Transfer dt = build_transfer(f, c);
+    ASSERT_TRUE(dt.axis[0].j0.on_device());
+    const Field<real> dxf = on_device(xf), dxc = on_device(xc);
+    dc.resize(3 * c.nodes());
+    restrict_to_coarse(dt, 3, dxf.data(), dc.data());
+    prolongate(dt, 3, dxc.data(), df.data(), true);
+  }
+  EXPECT_LE(test::max_abs_diff(dc.to_vector(), hc), 1e-14 * test::max_abs(hc));
+  EXPECT_LE(test::max_abs_diff(df.to_vector(), hf), 1e-14 * test::max_abs(hf));
+}
+
+// a whole MG-preconditioned CG solve with every operator, level and Krylov
+// vector made on the device: the host's iterations and solution
+TEST(Device, MultigridSolveOnTheDeviceMatchesTheHost) {
+  if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
+  for (Precision prec : {Precision::double_precision, Precision::single_precision})
+    for (bool odd : {false, true}) {
+      const Problem P = odd ? make_problem(spec_for_dims(23, 11, 13)) : make_problem(spec_for_level(5));
+      MGOptions mo;
+      mo.precision = prec;
+      mo.coarse_nodes = 60;
+      const Multigrid hmg(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
+      const InteriorSolution h = solve_interior_elasticity(P, hmg, 1e-10);
+      InteriorSolution d;
+      {
+        OnDevice on;
+        const Multigrid dmg(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
+        ASSERT_EQ(dmg.num_levels(), hmg.num_levels());
+        ASSERT_TRUE(dmg.op(0).stencil().groups.on_device());
+        d = solve_interior_elasticity(P, dmg, 1e-10);
+        EXPECT_TRUE(d.u.on_device());
+      }
+      const std::string what = std::string(to_string(prec)) + (odd ? ", 23x11x13" : ", level 5");
+      ASSERT_TRUE(h.stats.ok() && d.stats.ok()) << what;
+      EXPECT_EQ(d.stats.iterations, h.stats.iterations) << what;
+      EXPECT_NEAR(d.relative_residual, h.relative_residual, 0.1 * h.relative_residual) << what;
+      const std::vector<real> hu = h.u.to_vector();
+      EXPECT_LE(test::max_abs_diff(d.u.to_vector(), hu), 1e-10 * test::max_abs(hu)) << what;
+    }
+}
+
+// a multigrid made with the launches on the host, applied with them on the
+// device: refused with the reason, not read through host pointers
+TEST(Device, HostMadeMultigridIsRefusedOnTheDevice) {
+  if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
+  const Problem P = make_problem(spec_for_level(2));
+  const Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+  Field<real> r(P.dofs()), z(P.dofs());
+  OnDevice on;
+  EXPECT_THROW(mg.apply(r.data(), z.data()), std::logic_error);
 }
 
 }  // namespace tresca

@@ -33,7 +33,7 @@ SparseMatrix assemble(const ElasticityOperator& op) {
       for (index ix = 0; ix < g.nx(); ++ix)
         if (node_constrained(g, op.faces(), ix, iy, iz))
           for (int a = 0; a < 3; ++a) t.emplace_back(a * N + g.node(ix, iy, iz), a * N + g.node(ix, iy, iz), 1.0);
-  const Field<real>& B = op.bottom_block();
+  const std::vector<real> B = op.bottom_block().to_vector();  // (wherever it lives)
   if (!B.empty()) {
     const index M = g.nx() * g.ny();
     for (index n = 0; n < M; ++n) {

@@ -64,7 +64,7 @@ void ElasticityOperator::apply_planes(const real* x, real* y, index z_begin, ind
   apply_rows<real>(x, y, nullptr, z_begin, z_end);
 }
 
-void ElasticityOperator::set_bottom_block(const Field<real>& B) {
+void ElasticityOperator::set_bottom_block(const std::vector<real>& B) {
   const GridDims& G = slab_.global;
   const index M = G.nx() * G.ny();
   if (!B.empty() && index(B.size()) != 4 * M)
@@ -73,18 +73,21 @@ void ElasticityOperator::set_bottom_block(const Field<real>& B) {
   B_.clear();
   Bf_.clear();
   if (B.empty()) return;
-  Field<real> Bz = B;
+  std::vector<real> Bz = B;
   zero_constrained_bottom_block(G, global_faces_, Bz);
   const GridDims& g = slab_.local;
   const index Ml = g.nx() * g.ny(), row0 = slab_.y_begin - slab_.lo;
-  B_.assign(4 * Ml, 0.0);
+  std::vector<real> Bl(4 * Ml, 0.0);
   for (int f = 0; f < 4; ++f)  // owned rows only: ghost rows stay 0
     std::copy_n(Bz.data() + f * M + G.nx() * slab_.y_begin, G.nx() * slab_.owned_rows(),
-                B_.data() + f * Ml + g.nx() * (slab_.y_begin - row0));
-  Bf_.assign(B_.begin(), B_.end());
+                Bl.data() + f * Ml + g.nx() * (slab_.y_begin - row0));
+  B_.assign(Bl.begin(), Bl.end());
+  Bf_.assign(Bl.begin(), Bl.end());
+  B_.move_to(launch_space());
+  Bf_.move_to(launch_space());
 }
 
-void zero_constrained_bottom_block(const GridDims& g, unsigned faces, Field<real>& B) {
+void zero_constrained_bottom_block(const GridDims& g, unsigned faces, std::vector<real>& B) {
   if (B.empty()) return;
   const index M = g.nx() * g.ny();
   for (index iy = 0; iy < g.ny(); ++iy)
@@ -96,21 +99,13 @@ void zero_constrained_bottom_block(const GridDims& g, unsigned faces, Field<real
 Field<real> ElasticityOperator::diagonal() const {
   Field<real> d(size());
   elasticity_diagonal(k_, d.data());
-  if (!B_.empty()) {
-    const GridDims& g = slab_.local;
-    const index M = g.nx() * g.ny(), N = g.nodes();
-    for (index n = 0; n < M; ++n) {
-      d[n] += B_[n];
-      d[N + n] += B_[2 * M + n];
-      d[2 * N + n] += B_[3 * M + n];
-    }
-  }
+  if (!B_.empty()) bottom_block_diagonal(slab_.local, B_.data(), d.data());
   halo_.zero_ghosts(d.data());
   return d;
 }
 
 JacobiPreconditioner::JacobiPreconditioner(const ElasticityOperator& K) : inv_(K.diagonal()) {
-  for (real& v : inv_) v = v != 0 ? 1 / v : 0;
+  reciprocal_or_zero(size(), inv_.data(), inv_.data());
 }
 
 void JacobiPreconditioner::apply(const real* r, real* z) const { hadamard(size(), inv_.data(), r, z); }

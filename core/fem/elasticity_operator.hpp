@@ -62,9 +62,10 @@ class ElasticityOperator : public LinearOperator {
   const HaloCounts& halo_counts() const { return halo_.counts(); }
 
   // B over the whole bottom plane of the global grid: 4 fields of nx*ny
-  // (bxx, bxy, byy, bzz); the operator keeps its owned rows. Entries on
+  // (bxx, bxy, byy, bzz), host data; the operator keeps its owned rows,
+  // where its launches run. Entries on
   // constrained nodes are ignored (set to zero); empty removes the term.
-  void set_bottom_block(const Field<real>& B);
+  void set_bottom_block(const std::vector<real>& B);
   // B on the local box's bottom plane (ghost rows 0); empty: none
   const Field<real>& bottom_block() const { return B_; }
 
@@ -91,7 +92,7 @@ class ElasticityOperator : public LinearOperator {
 
 // B (4 fields over the bottom plane of grid g) := 0 on the nodes of the
 // constrained faces; empty: nothing
-void zero_constrained_bottom_block(const GridDims& g, unsigned faces, Field<real>& B);
+void zero_constrained_bottom_block(const GridDims& g, unsigned faces, std::vector<real>& B);
 
 // z = D^{-1} r with D = diag(K + B) (Jacobi; 0 on ghost rows): a simple CG
 // preconditioner (the elastic driver's --pc jacobi, tests)

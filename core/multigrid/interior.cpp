@@ -16,8 +16,10 @@ InteriorSolution solve_interior_elasticity(const Problem& P, const Multigrid& mg
   auto norm = [&](const real* v) { return std::sqrt(reduce ? reduce->sum(dot(n, v, v)) : dot(n, v, v)); };
   InteriorSolution s;
   s.u.resize(n);
-  std::vector<real> b(n);
-  global_to_local(K.slab(), P.load.data(), b.data());
+  std::vector<real> local(n);
+  global_to_local(K.slab(), P.load.data(), local.data());
+  Field<real> b(local.begin(), local.end());  // where the launches run
+  b.move_to(launch_space());
   zero_constrained(K.grid(), K.faces(), b.data());
   K.zero_ghosts(b.data());
   CGOptions o;
@@ -32,7 +34,7 @@ InteriorSolution solve_interior_elasticity(const Problem& P, const Multigrid& mg
   K.residual(b.data(), s.u.data(), r.data());
   s.relative_residual = s.stats.rhs_norm > 0 ? norm(r.data()) / s.stats.rhs_norm : norm(r.data());
   K.zero_ghosts(s.u.data());
-  for (real v : s.u) s.max_abs_u = std::max(s.max_abs_u, std::abs(v));
+  for (real v : s.u.to_vector()) s.max_abs_u = std::max(s.max_abs_u, std::abs(v));
   s.max_abs_u = real(mg.hierarchy()->comm->max(s.max_abs_u));
   return s;
 }

@@ -228,7 +228,7 @@ void Multigrid::refresh_work() {
   for (size_t l = 0; l < levels_.size(); ++l) {
     const Field<real> d = levels_[l].A.diagonal();
     W[l].dinv.resize(d.size());
-    for (size_t i = 0; i < d.size(); ++i) W[l].dinv[i] = d[i] != 0 ? T(1 / d[i]) : T(0);  // ghost rows: 0
+    reciprocal_or_zero<T>(index(d.size()), d.data(), W[l].dinv.data());  // ghost rows: 0
   }
 }
 
@@ -236,9 +236,11 @@ void Multigrid::estimate_lmax(int l) {
   Level& lv = levels_[l];
   const GridHierarchy::Level& h = grids_->levels[l];
   const index n = lv.A.size();
-  Field<real> r(n), dinv = lv.A.diagonal();
-  for (real& v : dinv) v = v != 0 ? 1 / v : 0;
-  // the start vector by global dof index: runs of nx entries (one node row)
+  Field<real> dinv = lv.A.diagonal();
+  reciprocal_or_zero(n, dinv.data(), dinv.data());
+  // the start vector by global dof index: runs of nx entries (one node row),
+  // made on the host and moved where the launches run
+  std::vector<real> start(n);
   const GridDims &box = h.slab.local, &G = h.grid;
   const index N = box.nodes(), row0 = h.slab.y_begin - h.slab.lo;
   for (int c = 0; c < 3; ++c)
@@ -246,9 +248,11 @@ void Multigrid::estimate_lmax(int l) {
       for (index j = 0; j < box.ny(); ++j) {
         const index k0 = c * G.nodes() + G.node(0, row0 + j, iz);
         std::uint64_t s = Lcg::jump(12345, std::uint64_t(k0) + 1);
-        real* out = r.data() + c * N + box.node(0, j, iz);
+        real* out = start.data() + c * N + box.node(0, j, iz);
         for (index ix = 0; ix < box.nx(); ++ix, s = Lcg::a * s + Lcg::c) out[ix] = Lcg::value(s);
       }
+  Field<real> r(start.begin(), start.end());
+  r.move_to(launch_space());
   zero_constrained(box, lv.A.faces(), r.data());
   lv.A.zero_ghosts(r.data());
   lv.lmax = lanczos_lmax(
@@ -276,7 +280,7 @@ void Multigrid::set_bottom_block(const std::vector<real>& B) {
   if (!B.empty() && index(B.size()) != 4 * g0.nx() * g0.ny())
     throw std::invalid_argument("multigrid: bottom block has " + std::to_string(B.size()) + " entries, expected 4 x " +
                                 std::to_string(g0.nx() * g0.ny()));
-  Field<real> Bl(B.begin(), B.end());  // this level's, whole plane
+  std::vector<real> Bl = B;  // this level's, whole plane
   for (size_t l = 0; l < levels_.size(); ++l) {
     const ElasticityOperator& A = levels_[l].A;
     zero_constrained_bottom_block(grids_->levels[l].grid, A.global_faces(), Bl);
@@ -349,10 +353,15 @@ void Multigrid::vcycle(int l) const {
   const Work<T>& w = work<T>()[l];
   const index n = levels_[l].A.size();
   if (l + 1 == num_levels()) {  // on rank 0 (every rank if all levels are whole)
+    // on the host: the right-hand side there and the solution back (a
+    // copy each where the launches run on the device)
     ScopedTimer t(Kernel::coarse_solve);
-    for (index i = 0; i < n; ++i) cb_[i] = real(w.bp[i]);
+    std::vector<T> v(n);
+    space_copy(Space::host, v.data(), launch_space(), w.bp, n * sizeof(T));
+    for (index i = 0; i < n; ++i) cb_[i] = real(v[i]);
     cx_ = coarse_.solve(cb_);
-    for (index i = 0; i < n; ++i) w.xp[i] = T(cx_[i]);
+    for (index i = 0; i < n; ++i) v[i] = T(cx_[i]);
+    space_copy(launch_space(), w.xp, Space::host, v.data(), n * sizeof(T));
     return;
   }
   smooth<T>(l, true);
@@ -372,6 +381,10 @@ void Multigrid::vcycle(int l) const {
 
 void Multigrid::apply(const real* r, real* z) const {
   const index n = size();
+  if (levels_[0].A.stencil().groups.space() != launch_space())
+    throw std::logic_error(std::string("multigrid: built with launches on the ") +
+                           to_string(levels_[0].A.stencil().groups.space()) + ", applied with them on the " +
+                           to_string(launch_space()));
   // every level whole on several ranks: rank 0 alone, the answer to all
   const bool alone = grids_->agglomerated(0), run = !alone || comm().rank() == 0;
   if (opt_.precision == Precision::double_precision) {

@@ -38,11 +38,13 @@ real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const
   return 1.15 * std::max(es.eigenvalues().maxCoeff(), real(2));
 }
 
-Field<real> project_bottom_block(const Transfer& t, const Field<real>& Bf) {
+std::vector<real> project_bottom_block(const Transfer& td, const std::vector<real>& Bf) {
+  Transfer t = td;  // (its 1D lists: small)
+  t.move_to(Space::host);
   const GridDims &fg = t.fine, &cg = t.coarse;
   const index Mf = fg.nx() * fg.ny(), Mc = cg.nx() * cg.ny();
   const Interp1D &X = t.axis[0], &Y = t.axis[1];
-  Field<real> Bc(4 * Mc, 0.0);
+  std::vector<real> Bc(4 * Mc, 0.0);
   for (int fld = 0; fld < 4; ++fld)
     for (index jy = 0; jy < cg.ny(); ++jy)
       for (index jx = 0; jx < cg.nx(); ++jx) {

@@ -43,7 +43,8 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
 real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const Field<real>& dinv,
                   Field<real> r, const Reduction* reduce = nullptr);
 
-// the coarse bottom block P^T B of the fine one (4 fields of nx*ny each)
-Field<real> project_bottom_block(const Transfer& t, const Field<real>& fine);
+// the coarse bottom block P^T B of the fine one (4 fields of nx*ny each;
+// host data, t wherever it lives)
+std::vector<real> project_bottom_block(const Transfer& t, const std::vector<real>& fine);
 
 }  // namespace tresca
