@@ -16,7 +16,7 @@
 using namespace tresca;
 
 static const char* kHelp =
-    "usage: elastic [--level L | --dims EXxEYxEZ] [--E E] [--nu NU] [--rtol R] [--threads N]\n"
+    "usage: elastic [--level L | --dims EXxEYxEZ] [--E E] [--nu NU] [--rtol R] [--threads N] [--device D]\n"
     "Solves K_ii u = l_i of the seed benchmark (clamped at x=0 and on the contact face)\n"
     "with multigrid-preconditioned CG and prints a summary. Default: --level 6 --rtol 1e-10.\n"
     "Under mpirun -np P (P > 1) the mesh is split into P slabs along y.\n"
@@ -25,6 +25,8 @@ static const char* kHelp =
     "  --E E, --nu NU     material (default 2.1e9 Pa, 0.277)\n"
     "  --rtol R           relative residual of the CG solve (default 1e-10, in (0,1))\n"
     "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
+    "  --device cpu|gpu   where the kernels run (default cpu); gpu: every operator, multigrid\n"
+    "                     level and CG vector in the GPU's memory (a -DTRESCA_OFFLOAD=ON build)\n"
     "  -h, --help         this text;  --version  the version and the build (ISA, compiler)\n"
     "Exit status: 0 converged, 1 not converged, 2 bad input.\n";
 
@@ -32,12 +34,13 @@ int main(int argc, char** argv) {
   MpiSession mpi(argc, argv);
   const Comm& comm = Comm::world();
   try {
-    Args a(argc, argv, {"--level", "--dims", "--E", "--nu", "--rtol", "--threads"}, {});
+    Args a(argc, argv, {"--level", "--dims", "--E", "--nu", "--rtol", "--threads", "--device"}, {});
     if (answered_help_or_version(a, "elastic", kHelp)) return 0;
     const int threads = apply_threads(a);
     const ProblemSpec spec = spec_from_args(a, 6);
     const real rtol = a.real_value("--rtol", 1e-10);
     if (!(rtol > 0 && rtol < 1)) throw std::invalid_argument("--rtol " + a.str("--rtol") + " must lie in (0,1)");
+    const std::string device = apply_device(a, comm);
     warn_if_cores_busy();
     const double t0 = wall_time();
     const Problem P = make_problem(spec);  // every rank builds the whole load
@@ -51,6 +54,7 @@ int main(int argc, char** argv) {
       std::printf("mesh            : %s (level %d)\n", dims_string(spec).c_str(), spec.level);
       std::printf("nodes / dofs    : %lld / %lld\n", (long long)P.nodes(), (long long)P.dofs());
       std::printf("ranks x threads : %d x %d%s\n", comm.size(), threads, comm.distributed() ? " (y-slabs)" : "");
+      std::printf("kernels on      : %s\n", device.c_str());
       std::printf("multigrid       : %s\n", mg.describe().c_str());
       std::printf("cg              : %s after %d iterations\n", to_string(st.reason), st.iterations);
       std::printf("rel. residual   : %.3e (recomputed)\n", double(sol.relative_residual));

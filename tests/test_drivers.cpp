@@ -75,6 +75,10 @@ TEST(ElasticDriver, RejectsBadInputWithOneLineNamingTheValue) {
   expect_error("elastic --dims 4x4", "4x4");
   expect_error("elastic --dims 4x0x3", "4x0x3");
   expect_error("elastic --dims axbxc", "axbxc");
+  expect_error("elastic --device tpu", "tpu");
+#ifndef TRESCA_OFFLOAD
+  expect_error("elastic --device gpu", "-DTRESCA_OFFLOAD=ON");
+#endif
   expect_error("elastic --level abc", "abc");
   expect_error("elastic --frobnicate", "--frobnicate");
 }

@@ -148,6 +148,7 @@ GridDims grid_of(const ProblemSpec& spec) {
 }
 
 Problem make_problem(const ProblemSpec& spec) {
+  HostLaunches host;  // the problem's description, the load included, is host data
   validate(spec);
   Problem P;
   P.spec = spec;

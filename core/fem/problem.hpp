@@ -93,7 +93,7 @@ struct Problem {
   GridDims grid;
   unsigned dirichlet_faces = kFaceX0;              // K: u = 0 on x = 0
   unsigned interior_faces = kFaceX0 | kFaceZ0;     // K_ii: also the contact face
-  Field<real> load;                                // l, SoA, 3N
+  Field<real> load;                                // l, SoA, 3N (host memory)
   index contact_nodes() const { return spec.contact_nodes(); }
   // grid node of contact node c
   index contact_grid_node(index c) const { return tresca::contact_grid_node(grid, c); }

@@ -1,6 +1,7 @@
 #include "core/io/cli.hpp"
 
 #include "core/parallel/comm.hpp"
+#include "kernels/launch.hpp"
 #include "kernels/simd.hpp"
 
 #include <algorithm>
@@ -340,6 +341,18 @@ int apply_threads(const Args& a) {
     omp_set_num_threads(int(t));
   }
   return omp_get_max_threads();
+}
+
+std::string apply_device(const Args& a, const Comm& comm) {
+  const std::string d = a.has("--device") ? a.str("--device") : "cpu";
+  if (d != "cpu" && d != "gpu") fail("--device " + d + " must be cpu or gpu");
+  if (d == "cpu") return "cpu";
+  if (!offload_built()) fail("--device gpu: this build has no device backend (configure with -DTRESCA_OFFLOAD=ON)");
+  if (comm.distributed()) fail("--device gpu runs on one rank (started as " + std::to_string(comm.size()) + ")");
+  set_launch_on_device(true);
+  if (omp_get_num_devices() == 0 && comm.rank() == 0)
+    std::fprintf(stderr, "warning: --device gpu, but no GPU is usable: the target regions run on the host\n");
+  return "gpu, " + device_description();
 }
 
 std::string dims_string(const ProblemSpec& s) {

@@ -11,6 +11,8 @@
 
 namespace tresca {
 
+class Comm;
+
 class Args {
  public:
   // flags: options taking a value ("--level"); switches: options without
@@ -79,6 +81,13 @@ std::string huge_page_setting();
 void require_one_rank(const char* program);
 // --threads N (else OMP_NUM_THREADS / all cores); returns the thread count in use
 int apply_threads(const Args& a);
+// --device cpu|gpu (default cpu): with gpu, the launches and the Fields made
+// from here on go to the offload device (kernels/launch.hpp); a bad input
+// error without an offload build (configure with -DTRESCA_OFFLOAD=ON) or on
+// several ranks. Returns what runs the kernels, for the run's header: "cpu",
+// or the device (with a warning on stderr where no GPU is present and the
+// target regions run on the host).
+std::string apply_device(const Args& a, const Comm& comm);
 std::string dims_string(const ProblemSpec& s);
 
 }  // namespace tresca
