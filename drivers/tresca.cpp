@@ -63,6 +63,7 @@ const char* kHelp =
     "  --mg-precision single|double  arithmetic of the multigrid V-cycles (default single;\n"
     "                     the Krylov solvers and all results are double either way)\n"
     "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
+    "  --device cpu       where the kernels run: the CPU (the GPU: elastic --device gpu so far)\n"
     "  --json FILE        write the run summary as one JSON object (rows with --table)\n"
     "  --contact-csv FILE one row per contact node\n"
     "  --vtk FILE.vtu     the body for ParaView: the undeformed mesh with the displacement u\n"
@@ -236,6 +237,10 @@ void check_outputs(const Command& c, const Comm& comm) {
 // at its own initial iterate); std::invalid_argument names what is wrong
 void parse_command(const Args& a, const Comm& comm, Command& c) {
   c.threads = apply_threads(a);
+  if (a.has("--device") && a.str("--device") != "cpu")
+    throw std::invalid_argument("--device " + a.str("--device") +
+                                ": the contact solve runs on the CPU only so far (issue 22: its contact-face "
+                                "vectors are not on the device yet); elastic --device gpu solves on the GPU");
   c.table = a.str("--table");
   const bool table = !c.table.empty();
   if (table) {
@@ -545,7 +550,7 @@ int main(int argc, char** argv) {
                  {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--mg-degree", "--scaling",
                   "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem", "--gap-file",
-                  "--vtk-format", "--initial"},
+                  "--vtk-format", "--initial", "--device"},
                  {"--quiet", "--profile", "--no-nested", "--vtk-every-iteration"});
     if (answered_help_or_version(a, "tresca", kHelp)) return 0;
     parse_command(a, comm, c);

@@ -33,22 +33,34 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
 
 SteklovPoincare::~SteklovPoincare() = default;
 
+// the contact face's nodes in a 3D vector of box g: node c (this rank's
+// c - c_begin) is ix = 1 + c % ex, row c / ex - row0, iz = 0
 void SteklovPoincare::scatter(const real* vc, real* full) const {
-  const GridDims& g = box();
-  const index N = g.nodes(), ex = P_.grid.ex, row0 = slab().y_begin - slab().lo;
-  for (index c = c_begin_; c < c_end_; ++c) {
-    const index n = g.node(1 + c % ex, c / ex - row0, 0);
-    for (int a = 0; a < 3; ++a) full[a * N + n] = vc[a * p_ + c - c_begin_];
+  const real* f = vc;
+  if (launch_space() != Space::host) {  // the contact values to where the launches run
+    face_.resize(3 * p_);
+    space_copy(launch_space(), face_.data(), Space::host, vc, 3 * p_ * sizeof(real));
+    f = face_.data();
   }
+  const index N = box().nodes(), nx = box().nx(), ex = P_.grid.ex, row0 = slab().y_begin - slab().lo, c0 = c_begin_,
+              p = p_;
+  for_each_entry(p, Cost{48, 0}, [=](index k) {
+    const index c = c0 + k, n = 1 + c % ex + nx * (c / ex - row0);
+    for (int a = 0; a < 3; ++a) full[a * N + n] = f[a * p + k];
+  });
 }
 
 void SteklovPoincare::gather(const real* full, real* vc) const {
-  const GridDims& g = box();
-  const index N = g.nodes(), ex = P_.grid.ex, row0 = slab().y_begin - slab().lo;
-  for (index c = c_begin_; c < c_end_; ++c) {
-    const index n = g.node(1 + c % ex, c / ex - row0, 0);
-    for (int a = 0; a < 3; ++a) vc[a * p_ + c - c_begin_] = full[a * N + n];
-  }
+  const bool staged = launch_space() != Space::host;
+  if (staged) face_.resize(3 * p_);
+  real* f = staged ? face_.data() : vc;
+  const index N = box().nodes(), nx = box().nx(), ex = P_.grid.ex, row0 = slab().y_begin - slab().lo, c0 = c_begin_,
+              p = p_;
+  for_each_entry(p, Cost{48, 0}, [=](index k) {
+    const index c = c0 + k, n = 1 + c % ex + nx * (c / ex - row0);
+    for (int a = 0; a < 3; ++a) f[a * p + k] = full[a * N + n];
+  });
+  if (staged) space_copy(Space::host, vc, launch_space(), f, 3 * p_ * sizeof(real));
 }
 
 real SteklovPoincare::sum(real local) const { return comm_.sum(local); }

@@ -100,7 +100,8 @@ class SteklovPoincare {
   const Problem& problem() const { return P_; }
 
   // scatter contact values into / gather them from a full SoA grid vector
-  // (this rank's contact nodes and rows)
+  // (this rank's contact nodes and rows); the contact values in host
+  // memory, the grid vector where the launches run
   void scatter(const real* vc, real* full) const;
   void gather(const real* full, real* vc) const;
 
@@ -126,6 +127,7 @@ class SteklovPoincare {
   std::vector<int> counts_, displs_;           // every rank's contact nodes (whole())
   mutable CGWorkspace ws_;  // scratch
   mutable Field<real> w_, t_, z_, load_;  // load_: residual()'s l on this rank's rows
+  mutable Field<real> face_;              // contact values where the launches run (device: staged)
 };
 
 }  // namespace tresca
