@@ -12,6 +12,10 @@
 // kernel headers). A kernel's roofline bound is max(bytes / triad, flops /
 // peak); "of bound" is that bound over the measured time (100 % = at the
 // roof). Output: one aligned table, and with --json FILE the same as JSON.
+// With --device gpu (an offload build) the same on the device: every field
+// in its memory, the triad measured there (a GPU writes whole lines without
+// reading them, so the bound is the STREAM count itself), and no flop peak
+// (the bound is the bandwidth's).
 //   OMP_NUM_THREADS=2 build/bin/roofline --level 10 --json roofline.json
 #include <omp.h>
 
@@ -19,6 +23,7 @@
 #include <cstdio>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -68,7 +73,7 @@ double fma_peak(long iterations) {
 }
 
 const char* kHelp =
-    "usage: roofline [--level L] [--threads N] [--reps R] [--json FILE]\n"
+    "usage: roofline [--level L] [--threads N] [--reps R] [--json FILE] [--device cpu|gpu]\n"
     "This machine's limits (STREAM triad bandwidth, FMA peak) and every kernel on the fields\n"
     "of mesh level L against them: time, items/s, GB/s and GFLOP/s from the kernels' modelled\n"
     "bytes and flops, and the fraction of the roofline bound max(bytes/BW, flops/peak).\n"
@@ -78,7 +83,17 @@ const char* kHelp =
     "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
     "  --reps R           repetitions per kernel, the best one kept (default 20)\n"
     "  --json FILE        the same as one JSON object\n"
+    "  --device cpu|gpu   where the kernels and their fields are (default cpu; gpu: an offload\n"
+    "                     build, measured against the device's own triad, no flop peak)\n"
     "  -h, --help         this text;  --version  the version and the build (ISA, compiler)\n";
+
+// host values in a Field where the launches run
+template <class T>
+Field<T> placed(const std::vector<T>& h) {
+  Field<T> f(h.begin(), h.end());
+  f.move_to(launch_space());
+  return f;
+}
 
 struct Row {
   std::string name;
@@ -92,9 +107,11 @@ struct Row {
 int main(int argc, char** argv) {
   require_one_rank("roofline");
   try {
-    Args a(argc, argv, {"--level", "--threads", "--reps", "--json"}, {});
+    Args a(argc, argv, {"--level", "--threads", "--reps", "--json", "--device"}, {});
     if (answered_help_or_version(a, "roofline", kHelp)) return 0;
     const int threads = apply_threads(a);
+    const std::string device = apply_device(a, Comm::self());
+    const bool on_device = launch_on_device();
     const long long level = a.int_value("--level", 10);
     const long long reps = a.int_value("--reps", 20);
     if (reps < 1 || reps > 100000) throw std::invalid_argument("--reps " + a.str("--reps") + " must be in 1..100000");
@@ -105,37 +122,44 @@ int main(int argc, char** argv) {
 
     warn_if_cores_busy();
     const double stream = triad_bandwidth(tresca::index(1) << 25, int(std::min(reps, 10LL)));
-    const double bw = stream * 32.0 / 24.0;  // with the write-allocate read of a
-    const double peak = fma_peak<double>(20000000), peak_single = fma_peak<float>(20000000);
-    std::printf("# %s, %d threads\n", build_info().c_str(), threads);
-    std::printf("# machine: triad %.2f GB/s (STREAM count), %.2f GB/s of traffic with write-allocate (the bound);\n"
-                "#          FMA peak %.2f GFLOP/s double, %.2f single; machine balance %.1f flop/byte (double)\n",
-                stream * 1e-9, bw * 1e-9, peak * 1e-9, peak_single * 1e-9, peak / bw);
+    const double bw = on_device ? stream : stream * 32.0 / 24.0;  // (CPU: with the write-allocate read of a)
+    const double none = std::numeric_limits<double>::infinity();  // no flop bound
+    const double peak = on_device ? none : fma_peak<double>(20000000);
+    const double peak_single = on_device ? none : fma_peak<float>(20000000);
+    std::printf("# %s, %d threads; kernels on %s\n", build_info().c_str(), threads, device.c_str());
+    if (on_device)
+      std::printf("# device: triad %.2f GB/s (STREAM count, the bound); no flop peak measured\n", stream * 1e-9);
+    else
+      std::printf("# machine: triad %.2f GB/s (STREAM count), %.2f GB/s of traffic with write-allocate (the bound);\n"
+                  "#          FMA peak %.2f GFLOP/s double, %.2f single; machine balance %.1f flop/byte (double)\n",
+                  stream * 1e-9, bw * 1e-9, peak * 1e-9, peak_single * 1e-9, peak / bw);
 
     const Problem P = make_problem(spec);
     const GridDims& g = P.grid;
     const tresca::index N = g.nodes(), n = 3 * N, M = g.nx() * g.ny();
     // the triad over three vectors of this level: well above the memory
     // triad where they fit in the caches, and then so do the kernels' fields
-    const double level_triad = triad_bandwidth(n, int(std::min(reps, 10LL))) * 32.0 / 24.0;
+    const double level_triad = triad_bandwidth(n, int(std::min(reps, 10LL))) * bw / stream;
     const bool cache_resident = level_triad > 1.25 * bw;
     const ElasticityStencil k = build_elasticity_stencil(g, P.interior_faces, P.spec.E, P.spec.nu);
-    std::vector<real> x(n), y(n), b(n), z(n), w(n), B(4 * M, 1.0);
+    std::vector<real> hx(n), hb(n);
     for (tresca::index i = 0; i < n; ++i) {
-      x[i] = real((i * 7919) % 1000) * 1e-3;
-      b[i] = real((i * 104729) % 1000) * 1e-3;
+      hx[i] = real((i * 7919) % 1000) * 1e-3;
+      hb[i] = real((i * 104729) % 1000) * 1e-3;
     }
+    Field<real> x = placed(hx), b = placed(hb), y(n), z(n), w(n), B = placed(std::vector<real>(4 * M, 1.0));
     GridDims c = g;
     c.ex = (c.ex + 1) / 2;
     c.ey = (c.ey + 1) / 2;
     c.ez = (c.ez + 1) / 2;
     const Transfer t = build_transfer(g, c);
-    std::vector<real> xc(3 * c.nodes(), 0.5);
+    Field<real> xc = placed(std::vector<real>(3 * c.nodes(), 0.5));
     Multigrid mg(g, P.interior_faces, P.spec.E, P.spec.nu);
     // the approximation step on as many nodes as the grid has (a streaming
     // size; the benchmark's own contact face is small enough to sit in cache)
-    std::vector<real> lam(N, 1.0), phi(N, 1.0), gap(N, 0.0), scale(N, 2e8), v(4 * N), w4(4 * N), d(3 * N);
-    std::vector<std::uint8_t> status(N);
+    Field<real> lam = placed(std::vector<real>(N, 1.0)), phi = lam, gap(N), scale = placed(std::vector<real>(N, 2e8)),
+                v(4 * N), w4(4 * N), d(3 * N);
+    Field<std::uint8_t> status(N);
 
     const int R = int(reps);
     const double nodes = double(N), dofs = double(n);
@@ -145,7 +169,7 @@ int main(int argc, char** argv) {
     };
     add("apply y = Kx", dofs, nodes * kApplyCost, [&] { elasticity_apply(k, x.data(), y.data(), 0, g.nz()); });
     const ElasticityStencilT<float> kf = stencil_in_precision<float>(k);
-    std::vector<float> xf(x.begin(), x.end()), yf(n);
+    Field<float> xf = placed(std::vector<float>(hx.begin(), hx.end())), yf(n);
     add("apply (float)", dofs, nodes * in_precision<float>(kApplyCost),
         [&] { elasticity_apply<float>(kf, xf.data(), yf.data(), 0, g.nz()); }, true);
     add("residual b - Kx", dofs, nodes * kResidualCost,
@@ -154,7 +178,8 @@ int main(int argc, char** argv) {
         [&] { bottom_block_apply(g, 1e-9, B.data(), x.data(), y.data()); });
     add("restriction", dofs, dofs * kRestrictCost, [&] { restrict_to_coarse(t, 3, x.data(), xc.data()); });
     add("prolongation (+=)", dofs, dofs * kProlongateCost, [&] { prolongate(t, 3, xc.data(), y.data(), true); });
-    add("dot", dofs, dofs * kDotCost, [&] { w[0] += 1e-300 * dot(n, x.data(), b.data()); });
+    real sink = 0;
+    add("dot", dofs, dofs * kDotCost, [&] { sink += 1e-300 * dot(n, x.data(), b.data()); });
     add("axpy", dofs, dofs * kAxpyCost, [&] { axpy(n, 1e-9, x.data(), y.data()); });
     add("cg_update", dofs, dofs * kCgUpdateCost, [&] { cg_update(n, 1e-9, x.data(), b.data(), z.data(), w.data()); });
     add("cheb_update", dofs, dofs * kChebUpdateCost,
@@ -183,9 +208,11 @@ int main(int argc, char** argv) {
       const double gbs = r.cost.bytes / r.seconds, gfs = r.cost.flops / r.seconds;
       const double pk = r.single ? peak_single : peak;
       const double bound = std::max(r.cost.bytes / bw, r.cost.flops / pk);
+      char of_peak[16] = "-";
+      if (!on_device) std::snprintf(of_peak, sizeof of_peak, "%.0f%%", 100 * gfs / pk);
       if (r.cost.bytes > 0)
-        std::printf("%-20s %10.3f %11.1f %8.2f %7.0f%% %9.2f %7.0f%% %8.0f%%\n", r.name.c_str(), r.seconds * 1e3,
-                    r.items / r.seconds * 1e-6, gbs * 1e-9, 100 * gbs / bw, gfs * 1e-9, 100 * gfs / pk,
+        std::printf("%-20s %10.3f %11.1f %8.2f %7.0f%% %9.2f %8s %8.0f%%\n", r.name.c_str(), r.seconds * 1e3,
+                    r.items / r.seconds * 1e-6, gbs * 1e-9, 100 * gbs / bw, gfs * 1e-9, of_peak,
                     100 * bound / r.seconds);
       else
         std::printf("%-20s %10.3f %11.1f %8s %8s %9s %8s %9s\n", r.name.c_str(), r.seconds * 1e3,
@@ -196,18 +223,20 @@ int main(int argc, char** argv) {
                          {"bytes_per_s", gbs},
                          {"flops_per_s", gfs},
                          {"fraction_of_bandwidth", gbs / bw},
-                         {"fraction_of_peak", gfs / pk},
+                         {"fraction_of_peak", on_device ? Json(nullptr) : Json(gfs / pk)},
                          {"fraction_of_bound", bound / r.seconds}});
     }
+    if (sink != sink) std::printf("# (dot: not finite)\n");
     const Json out = {{"build", build_info()},
                       {"threads", threads},
+                      {"device", device},
                       {"level", level},
                       {"triad_stream_bytes_per_s", stream},
                       {"bandwidth_bytes_per_s", bw},
                       {"level_triad_bytes_per_s", level_triad},
                       {"cache_resident", cache_resident},
-                      {"peak_flops_per_s", peak},
-                      {"peak_flops_per_s_single", peak_single},
+                      {"peak_flops_per_s", on_device ? Json(nullptr) : Json(peak)},
+                      {"peak_flops_per_s_single", on_device ? Json(nullptr) : Json(peak_single)},
                       {"kernels", kernels}};
     if (!json.empty()) write_file_atomic(json, json_text(out));
     return 0;
