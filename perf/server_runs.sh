@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Issue 21's measurements on a many-core server (the test machine's 16
+# cores: ../shared/device/README.md), in stages that each fit in one
+# 10-minute command. From the project root, with a build of the project
+# (there: bash .device-kit/build.sh /tmp/b):
+#   bash perf/server_runs.sh BUILD STAGE
+# STAGE:
+#   threads   level 12 with all cores as threads (libgomp's default wait,
+#             OMP_WAIT_POLICY=active, passive; each placed close on cores)
+#             and as MPI ranks: issue 21's "16 threads within 10 % of 16 ranks"
+#   scaling   scaling --threads 1,2,4,8,16 on levels 10-12: speed-up and
+#             efficiency against the bandwidth-ideal speed-up
+#   ranks     scaling --ranks 1,2,4,8,16 on level 12
+#   roofline  roofline --level 12 with all cores: every kernel against the triad
+#   large     levels 13 and 14 with all cores, then level 15 (memory
+#             estimate, time, peak memory)
+# LEVEL, LEVELS, SWEEP and THREADS replace 12, 10-12, 1,2,4,8,16 and the
+# core count (e.g. LEVEL=4 LEVELS=3-4 SWEEP=1,2 to try it on 2 cores).
+# Each stage prints what it ran (command, date, machine) before its figures:
+# paste them into perf/RESULTS.md as they are.
+set -euo pipefail
+b=${1:?usage: bash perf/server_runs.sh BUILD STAGE}
+stage=${2:?usage: bash perf/server_runs.sh BUILD STAGE}
+T=${THREADS:-$(nproc)}
+L=${LEVEL:-12} LS=${LEVELS:-10-12}  # (smaller ones try the script out on a small machine)
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1  # (the test machine runs as root)
+echo "# $(date -u '+%F %H:%M UTC'); $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) CPUs; build $b"
+echo "# stage $stage, $T threads or ranks"
+run() {  # a command, echoed, then its last TAIL lines (or those matching KEEP)
+  echo "\$ $*"
+  if [ -n "${KEEP:-}" ]; then
+    { "$@" 2>&1 || echo "(exit status $?)"; } | grep -E "$KEEP|exit status"
+  else
+    { "$@" 2>&1 || echo "(exit status $?)"; } | tail -n "${TAIL:-3}"
+  fi
+}
+solve='times \[s\]|peak memory|error'  # a solve's lines worth keeping
+case $stage in
+  threads)
+    for wait in default active passive; do
+      for rep in 1 2 3; do
+        if [ "$wait" = default ]; then w=(env -u OMP_WAIT_POLICY); else w=(env OMP_WAIT_POLICY=$wait); fi
+        KEEP=$solve run "${w[@]}" OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores "$b/bin/tresca" --level "$L" --quiet
+      done
+    done
+    if command -v mpirun > /dev/null; then
+      for rep in 1 2 3; do
+        KEEP=$solve run mpirun -np "$T" --bind-to core -x OMP_NUM_THREADS=1 "$b/bin/tresca" --level "$L" --quiet
+      done
+    fi ;;
+  scaling)
+    TAIL=40 run env OMP_PROC_BIND=close OMP_PLACES=cores "$b/bin/scaling" --levels "$LS" --threads "${SWEEP:-1,2,4,8,16}" ;;
+  ranks)
+    TAIL=20 run "$b/bin/scaling" --levels "$L-$L" --ranks "${SWEEP:-1,2,4,8,16}" ;;
+  roofline)
+    TAIL=30 run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores "$b/bin/roofline" --level "$L" ;;
+  large)
+    for level in 13 14 15; do
+      KEEP="$solve|estimated|converged" run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores \
+        "$b/bin/tresca" --level "$level"
+    done ;;
+  *)
+    echo "unknown stage '$stage': threads, scaling, ranks, roofline or large" >&2
+    exit 2 ;;
+esac
