@@ -15,9 +15,9 @@
 // writing entries on the host (operator[], begin/end, front/back,
 // push_back) is allowed on a host Field only, and throws std::logic_error
 // on a device one: a solve that should stay on the device cannot quietly
-// read through a device pointer. Code that builds data on the host runs
-// inside a HostLaunches scope (launch.hpp) and lets its owner move the
-// result (the owners' move_to). Entries are trivially copyable; new
+// read through a device pointer. Code that builds data entry by entry runs
+// inside a HostLaunches scope (launch.hpp) and moves its result to where
+// the launches ran before (move_to). Entries are trivially copyable; new
 // entries are zero (T{}).
 //
 // Host storage of 1 MiB or more is aligned to 2 MiB and marked
@@ -107,6 +107,7 @@ class Field {
   const T& back() const { return host()[n_ - 1]; }
   void push_back(const T& v) {
     if (cap_ == 0) space_ = Space::host;
+    host();  // (refused on a device Field before it grows)
     if (n_ == cap_) reserve_in(space_, std::max<index>(16, 2 * cap_));
     host()[n_++] = v;
   }

@@ -145,7 +145,12 @@ void space_zero(Space s, void* p, std::size_t bytes) {
     return;
   }
 #endif
-  std::memset(p, 0, bytes);  // (without offload, "device" memory is the host's)
+  if (s == Space::device) {  // without offload, "device" memory is the host's
+    DeviceRegion region;
+    std::memset(p, 0, bytes);
+    return;
+  }
+  std::memset(p, 0, bytes);
 }
 
 bool device_guarded() { return guard().on; }

@@ -43,9 +43,11 @@ bool offload_built();                // whether this build has TRESCA_OFFLOAD
 // "device 0 of 1 (OpenMP offload)", or "none: target regions run on the host"
 std::string device_description();
 
-// Launches run on the host inside this scope (setup code that fills Fields
-// entry by entry; its owner then moves them: field.hpp), and where they ran
-// before after it.
+// Launches (and new Fields) are the host's inside this scope, and where
+// they were before after it: for builders that fill Fields entry by entry
+// and then move what they made to space_before() (build_elasticity_stencil,
+// build_transfer). A builder called inside another's scope builds on the
+// host, and the outer one moves the whole.
 class HostLaunches {
  public:
   HostLaunches() : was_(launch_on_device()) { set_launch_on_device(false); }
