@@ -169,9 +169,12 @@ inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost 
 // Sum of block(i0, i1) over the fixed blocks [b*width, (b+1)*width) of
 // [0, n): the blocks in parallel, their sums added in order afterwards, so
 // the result is bitwise the same for any number of workers. Each caller's
-// block is a loop over plain pointers (vectorised with contiguous loads).
-template <class Block>
-inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& block) {
+// block is a loop over plain pointers (the CPU's explicit vectors,
+// simd.hpp). entry(i) is the same sum's term of one entry, the device's
+// form: a team per block, its entries across the team's threads and lanes
+// (one GPU thread walking a block of 4096 would read memory uncoalesced).
+template <class Block, class Entry>
+inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& block, const Entry& entry) {
   const index nb = (n + width - 1) / width;
   constexpr index kStack = 256;
   real stack[kStack];
@@ -181,12 +184,19 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
     heap.resize(nb);
     part = heap.data();
   }
+  (void)entry;  // (the host's form is block)
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
     DeviceRegion region;
-    Block bl = block;
-#pragma omp target teams distribute parallel for map(from : part[0 : nb])
-    for (index b = 0; b < nb; ++b) part[b] = bl(b * width, b + 1 < nb ? (b + 1) * width : n);
+    Entry e = entry;
+#pragma omp target teams distribute map(from : part[0 : nb])
+    for (index b = 0; b < nb; ++b) {
+      const index i1 = b + 1 < nb ? (b + 1) * width : n;
+      real s = 0;
+#pragma omp parallel for simd reduction(+ : s)
+      for (index i = b * width; i < i1; ++i) s += e(i);
+      part[b] = s;
+    }
   } else
 #endif
 #pragma omp parallel for schedule(static) if (worth_threads(double(n) * per_entry))

@@ -35,7 +35,7 @@ real dot(index n, const real* x, const real* y) {
     real s = hsum(s0 + s1);
     for (; i < i1; ++i) s += x[i] * y[i];
     return s;
-  });
+  }, [x, y](index i) { return x[i] * y[i]; });
 }
 
 real dot_ref(index n, const real* x, const real* y) {
@@ -84,6 +84,10 @@ real cg_update(index n, real a, const real* p, const real* q, real* x, real* r) 
       s += r[i] * r[i];
     }
     return s;
+  }, [=](index i) {
+    x[i] += a * p[i];
+    r[i] -= a * q[i];
+    return r[i] * r[i];
   });
 }
 
