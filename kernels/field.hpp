@@ -207,4 +207,12 @@ class Field {
   Space space_ = Space::host;
 };
 
+// host values (converted to T) in a Field where the launches run now
+template <class T, class U>
+Field<T> placed_field(const std::vector<U>& host) {
+  Field<T> f(host.begin(), host.end());
+  f.move_to(launch_space());
+  return f;
+}
+
 }  // namespace tresca

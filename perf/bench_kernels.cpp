@@ -59,14 +59,6 @@ void done(Run run) {
   if (run == Run::device) set_launch_on_device(false);
 }
 
-// host values in a Field where launches run
-template <class T>
-Field<T> field_of(const std::vector<real>& h) {
-  Field<T> f(h.begin(), h.end());
-  f.move_to(launch_space());
-  return f;
-}
-
 // T: double, float (the single-precision V-cycle's apply); Run::ref: the serial _ref twin (double)
 template <class T, Run kRun>
 void BM_Apply(benchmark::State& st) {
@@ -75,7 +67,7 @@ void BM_Apply(benchmark::State& st) {
   {
     const ElasticityStencil k = build_elasticity_stencil(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
     const ElasticityStencilT<T> kt = stencil_in_precision<T>(k);
-    Field<T> x = field_of<T>(ramp(k.size())), y(k.size());
+    Field<T> x = placed_field<T>(ramp(k.size())), y(k.size());
     for (auto _ : st) {
       if constexpr (kRun == Run::ref)
         elasticity_apply_ref(k, x.data(), y.data(), 0, P.grid.nz());
@@ -103,7 +95,7 @@ void BM_VCycle(benchmark::State& st) {
   if (!run_where(st, kRun)) return;
   {
     Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
-    Field<real> r = field_of<real>(h), z(P.dofs());
+    Field<real> r = placed_field<real>(h), z(P.dofs());
     for (auto _ : st) {
       mg.apply(r.data(), z.data());
       benchmark::DoNotOptimize(z.data());
@@ -125,7 +117,7 @@ void BM_Transfer(benchmark::State& st) {
   if (!run_where(st, kRun)) return;
   {
     const Transfer t = build_transfer(P.grid, c);
-    Field<real> f = field_of<real>(ramp(3 * P.grid.nodes())), cc(3 * c.nodes());
+    Field<real> f = placed_field<real>(ramp(3 * P.grid.nodes())), cc(3 * c.nodes());
     for (auto _ : st) {
       restrict_to_coarse(t, 3, f.data(), cc.data());
       prolongate(t, 3, cc.data(), f.data());
@@ -146,7 +138,7 @@ void BM_Vector(benchmark::State& st) {
   const std::vector<real> h = ramp(n);
   if (!run_where(st, kRun)) return;
   {
-    Field<real> v[4] = {field_of<real>(h), field_of<real>(h), field_of<real>(h), field_of<real>(h)};
+    Field<real> v[4] = {placed_field<real>(h), placed_field<real>(h), placed_field<real>(h), placed_field<real>(h)};
     for (auto _ : st) {
       if (kKernel == 0) benchmark::DoNotOptimize(dot(n, v[0].data(), v[1].data()));
       if (kKernel == 1) axpy(n, 1e-9, v[0].data(), v[1].data());

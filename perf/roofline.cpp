@@ -87,14 +87,6 @@ const char* kHelp =
     "                     build, measured against the device's own triad, no flop peak)\n"
     "  -h, --help         this text;  --version  the version and the build (ISA, compiler)\n";
 
-// host values in a Field where the launches run
-template <class T>
-Field<T> placed(const std::vector<T>& h) {
-  Field<T> f(h.begin(), h.end());
-  f.move_to(launch_space());
-  return f;
-}
-
 struct Row {
   std::string name;
   double items, seconds;
@@ -147,17 +139,17 @@ int main(int argc, char** argv) {
       hx[i] = real((i * 7919) % 1000) * 1e-3;
       hb[i] = real((i * 104729) % 1000) * 1e-3;
     }
-    Field<real> x = placed(hx), b = placed(hb), y(n), z(n), w(n), B = placed(std::vector<real>(4 * M, 1.0));
+    Field<real> x = placed_field<real>(hx), b = placed_field<real>(hb), y(n), z(n), w(n), B(4 * M, 1.0);
     GridDims c = g;
     c.ex = (c.ex + 1) / 2;
     c.ey = (c.ey + 1) / 2;
     c.ez = (c.ez + 1) / 2;
     const Transfer t = build_transfer(g, c);
-    Field<real> xc = placed(std::vector<real>(3 * c.nodes(), 0.5));
+    Field<real> xc(3 * c.nodes(), 0.5);
     Multigrid mg(g, P.interior_faces, P.spec.E, P.spec.nu);
     // the approximation step on as many nodes as the grid has (a streaming
     // size; the benchmark's own contact face is small enough to sit in cache)
-    Field<real> lam = placed(std::vector<real>(N, 1.0)), phi = lam, gap(N), scale = placed(std::vector<real>(N, 2e8)),
+    Field<real> lam(N, 1.0), phi(N, 1.0), gap(N), scale(N, 2e8),
                 v(4 * N), w4(4 * N), d(3 * N);
     Field<std::uint8_t> status(N);
 
@@ -169,7 +161,7 @@ int main(int argc, char** argv) {
     };
     add("apply y = Kx", dofs, nodes * kApplyCost, [&] { elasticity_apply(k, x.data(), y.data(), 0, g.nz()); });
     const ElasticityStencilT<float> kf = stencil_in_precision<float>(k);
-    Field<float> xf = placed(std::vector<float>(hx.begin(), hx.end())), yf(n);
+    Field<float> xf = placed_field<float>(hx), yf(n);
     add("apply (float)", dofs, nodes * in_precision<float>(kApplyCost),
         [&] { elasticity_apply<float>(kf, xf.data(), yf.data(), 0, g.nz()); }, true);
     add("residual b - Kx", dofs, nodes * kResidualCost,

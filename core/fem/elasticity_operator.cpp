@@ -81,10 +81,8 @@ void ElasticityOperator::set_bottom_block(const std::vector<real>& B) {
   for (int f = 0; f < 4; ++f)  // owned rows only: ghost rows stay 0
     std::copy_n(Bz.data() + f * M + G.nx() * slab_.y_begin, G.nx() * slab_.owned_rows(),
                 Bl.data() + f * Ml + g.nx() * (slab_.y_begin - row0));
-  B_.assign(Bl.begin(), Bl.end());
-  Bf_.assign(Bl.begin(), Bl.end());
-  B_.move_to(launch_space());
-  Bf_.move_to(launch_space());
+  B_ = placed_field<real>(Bl);
+  Bf_ = placed_field<float>(Bl);
 }
 
 void zero_constrained_bottom_block(const GridDims& g, unsigned faces, std::vector<real>& B) {

@@ -18,8 +18,7 @@ InteriorSolution solve_interior_elasticity(const Problem& P, const Multigrid& mg
   s.u.resize(n);
   std::vector<real> local(n);
   global_to_local(K.slab(), P.load.data(), local.data());
-  Field<real> b(local.begin(), local.end());  // where the launches run
-  b.move_to(launch_space());
+  Field<real> b = placed_field<real>(local);
   zero_constrained(K.grid(), K.faces(), b.data());
   K.zero_ghosts(b.data());
   CGOptions o;

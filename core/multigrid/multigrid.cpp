@@ -251,8 +251,7 @@ void Multigrid::estimate_lmax(int l) {
         real* out = start.data() + c * N + box.node(0, j, iz);
         for (index ix = 0; ix < box.nx(); ++ix, s = Lcg::a * s + Lcg::c) out[ix] = Lcg::value(s);
       }
-  Field<real> r(start.begin(), start.end());
-  r.move_to(launch_space());
+  Field<real> r = placed_field<real>(start);
   zero_constrained(box, lv.A.faces(), r.data());
   lv.A.zero_ghosts(r.data());
   lv.lmax = lanczos_lmax(
