@@ -26,13 +26,19 @@ inline NodeStep node_step(real s, real phi, real x1, real x2, real x3, real x4, 
 }  // namespace
 
 StateCounts count_states(index p, const std::uint8_t* status) {
+  // three counts where the status lives (each a deterministic sum)
+  auto count = [=](ContactState which) {
+    return index(sum_over_entries(p, Cost{1, 1}, [=](index i) { return real(contact_state(status[i]) == which); }));
+  };
   StateCounts c;
-  for (index i = 0; i < p; ++i) switch (contact_state(status[i])) {
-      case ContactState::separated: c.separated += 1; break;
-      case ContactState::stick: c.stick += 1; break;
-      case ContactState::slip: c.slip += 1; break;
-    }
+  c.separated = count(ContactState::separated);
+  c.stick = count(ContactState::stick);
+  c.slip = count(ContactState::slip);
   return c;
+}
+
+void coulomb_bound(index p, real F, const real* lambda, real* phi) {
+  for_each_entry(p, Cost{16, 2}, [=](index i) { phi[i] = F * (lambda[i] > 0 ? lambda[i] : real(0)); });
 }
 
 ResidualNorms approximation_step(index p, const ContactLaw& law, const real* scale, const real* units, const real* u,

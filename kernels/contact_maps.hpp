@@ -28,7 +28,8 @@
 //
 // DATA LAYOUT: SoA. u, r: [x | y | z] blocks of p; lambda, phi, gap, scale: p;
 // v: 4 blocks of p [v1 | v2 | v3 | v4]; d: 3 blocks [d1 | d2 | d4]; status:
-// p bytes (bit0 contact, bit1 stick).
+// p bytes (bit0 contact, bit1 stick). Every array lives where the launches
+// run (launch.hpp): the kernels below are launches.
 #pragma once
 #include <cstdint>
 
@@ -65,6 +66,9 @@ struct StateCounts {
   index contact() const { return stick + slip; }
 };
 StateCounts count_states(index p, const std::uint8_t* status);
+
+// Coulomb's bound at lambda: phi_i = F max(0, lambda_i)
+void coulomb_bound(index p, real F, const real* lambda, real* phi);
 
 // |v̂|^2 of the paper's step (s = 1, its rule (11)) and |w|^2 of the
 // residual in consistent units [N^2] (deterministic order)

@@ -206,4 +206,20 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
   return s;
 }
 
+// Sum of entry(i) over [0, n) by sum_over_blocks (deterministic, both
+// forms from the one term): for sums whose term is not worth an explicit
+// vector block (counts, reductions over contact nodes).
+template <class Entry>
+inline real sum_over_entries(index n, Cost per_entry, const Entry& entry) {
+  constexpr index kWidth = 4096;
+  return sum_over_blocks(
+      n, kWidth, per_entry,
+      [&](index i0, index i1) {
+        real s = 0;
+        for (index i = i0; i < i1; ++i) s += entry(i);
+        return s;
+      },
+      entry);
+}
+
 }  // namespace tresca

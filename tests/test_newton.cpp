@@ -621,8 +621,8 @@ TEST(BoundaryPreconditioner, IsSymmetricOnTheFreeDofs) {
     const SteklovPoincare S(P, mo);
     BoundaryPreconditioner M(S, mo);
     const index p = P.contact_nodes(), n = 3 * p;
-    std::vector<real> h(n, 0.0);
-    std::vector<std::uint8_t> fixed(n, 0), free(n, 1);
+    Field<real> h(n, 0.0);
+    Field<std::uint8_t> fixed(n, 0), free(n, 1);
     for (index i = 0; i < p; ++i) {
       if (i % 3 == 0) fixed[i] = fixed[p + i] = 1, free[i] = free[p + i] = 0;  // sticking
       else h[i] = 1e8, h[p + i] = -2e7, h[2 * p + i] = 3e8;                      // sliding: PSD block

@@ -145,7 +145,7 @@ TEST(ContactPatch, ShearBelowTheFrictionLimitSticksAboveItSlides) {
   spec.traction[kLoadZ1] = {2e7, 0, -1e8};  // shear along x and pressure on the top
   const Problem P = make_problem(spec);
   SteklovPoincare S(P);
-  std::vector<real> b;
+  Field<real> b;
   ASSERT_TRUE(S.condensed_load(1e-13, b).ok());
   const index p = P.contact_nodes();
   for (index c = 0; c < p; ++c) ASSERT_LT(b[2 * p + c], 0) << "the load presses every contact node";

@@ -47,7 +47,7 @@ TEST(SteklovPoincare, MatchesDenseSchurComplementAndIsSPD) {
     EXPECT_LT((Smf - Smf.transpose()).cwiseAbs().maxCoeff(), 1e-9 * scale);
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (Smf + Smf.transpose()));
     EXPECT_GT(es.eigenvalues().minCoeff(), 1e-6 * scale);
-    std::vector<real> b;
+    Field<real> b;
     ASSERT_TRUE(S.condensed_load(1e-13, b).ok());
     real berr = 0;
     for (index i = 0; i < n; ++i) berr = std::max(berr, std::abs(b[i] - d.b[i]));
@@ -63,8 +63,8 @@ TEST(SteklovPoincare, RecoveryAndResidualMatchDense) {
   for (auto& v : uc) v *= 1e-3;
   // u = E u_c + K_ii^{-1} l_i: the extension from an S apply, the interior
   // load solution from the condensed load
-  std::vector<real> u(3 * P.nodes()), b, Sv(S.size());
-  Field<real> li;
+  std::vector<real> u(3 * P.nodes()), Sv(S.size());
+  Field<real> b, li;
   ASSERT_TRUE(S.apply(uc.data(), Sv.data(), 1e-13, u.data()).ok());
   ASSERT_TRUE(S.condensed_load(1e-13, b, &li).ok());
   for (size_t i = 0; i < u.size(); ++i) u[i] += li[i];

@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "kernels/launch.hpp"
+
 namespace tresca {
 
 namespace {
@@ -21,14 +23,16 @@ BoundaryPreconditioner::BoundaryPreconditioner(const SteklovPoincare& S, const M
   full_out_.assign(S.full_size(), 0);
 }
 
-void BoundaryPreconditioner::update(const std::vector<real>& h, const std::vector<std::uint8_t>& fixed,
-                                    const std::vector<std::uint8_t>& free_mask) {
+void BoundaryPreconditioner::update(const Field<real>& h_placed, const Field<std::uint8_t>& fixed_placed,
+                                    const Field<std::uint8_t>& free_mask) {
   const Problem& P = S_.problem();
   const GridDims& g = P.grid;
   const index M = g.nx() * g.ny(), p = S_.contact_nodes(), first = S_.first_contact_node();
-  if (index(h.size()) != 3 * p || index(fixed.size()) != 3 * p || index(free_mask.size()) != 3 * p)
+  if (index(h_placed.size()) != 3 * p || index(fixed_placed.size()) != 3 * p || index(free_mask.size()) != 3 * p)
     throw std::invalid_argument("BoundaryPreconditioner::update: h, fixed and free must have 3p = " +
                                 std::to_string(3 * p) + " entries");
+  const std::vector<real> h = h_placed.to_vector();
+  const std::vector<std::uint8_t> fixed = fixed_placed.to_vector();
   // B over the whole bottom plane: this rank's contact nodes, then (several
   // ranks) the sum of every rank's, which own disjoint nodes
   std::vector<real> B(4 * M, 0.0);
@@ -50,8 +54,10 @@ void BoundaryPreconditioner::apply(const real* r, real* z) const {
   S_.scatter(r, full_in_.data());
   mg_->apply(full_in_.data(), full_out_.data());
   S_.gather(full_out_.data(), z);
-  for (index i = 0; i < size(); ++i)
-    if (!free_[i]) z[i] = 0;
+  const std::uint8_t* free = free_.data();
+  for_each_entry(size(), Cost{9, 0}, [=](index i) {
+    if (!free[i]) z[i] = 0;
+  });
 }
 
 }  // namespace tresca

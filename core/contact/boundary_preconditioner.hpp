@@ -34,20 +34,22 @@ class BoundaryPreconditioner : public LinearOperator {
   index size() const override { return S_.size(); }
   void apply(const real* r, real* z) const override;
 
-  // Rebuild B for the current Newton system: h (3 blocks of p: h11, h12, h22
-  // on sliding nodes), `fixed` (3p bytes, 1 where the increment is known)
-  // and `free` mask (3p bytes) of the reduced system.
   // work of one apply in fine-grid matvec equivalents (one V-cycle of K + B)
   double apply_work() const { return mg_->cycle_work(); }
 
-  void update(const std::vector<real>& h, const std::vector<std::uint8_t>& fixed,
-              const std::vector<std::uint8_t>& free_mask);
+  // Rebuild B for the current Newton system: h (3 blocks of p: h11, h12, h22
+  // on sliding nodes), `fixed` (3p bytes, 1 where the increment is known)
+  // and `free` mask (3p bytes) of the reduced system, where the launches
+  // run. B is set up on the host (the multigrid's bottom block and its
+  // coarse projections are host set-up: multigrid.hpp), so h and fixed
+  // cross once per Newton step; the applies stay where the launches run.
+  void update(const Field<real>& h, const Field<std::uint8_t>& fixed, const Field<std::uint8_t>& free_mask);
 
  private:
   const SteklovPoincare& S_;
   std::unique_ptr<Multigrid> mg_;  // K + B
   std::vector<real> kdiag_;  // diag of K at this rank's contact nodes (3 blocks)
-  std::vector<std::uint8_t> free_;
+  Field<std::uint8_t> free_;
   mutable Field<real> full_in_, full_out_;
 };
 

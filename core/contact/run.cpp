@@ -9,6 +9,7 @@
 #include "core/multigrid/multigrid.hpp"
 #include "core/parallel/row_fetch.hpp"
 #include "kernels/contact_maps.hpp"
+#include "kernels/launch.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
@@ -79,8 +80,12 @@ void solve_coarser_mesh(const ProblemSpec& spec, const RunOptions& opt, RunResul
   const index n = 3 * fine.local.nodes();
   start.load_guess.resize(n);
   start.body.resize(n);
-  prolongate_slabs(C.slab, C.interior_load.data(), fine, start.load_guess.data(), comm);
-  prolongate_slabs(C.slab, C.u_full.data(), fine, start.body.data(), comm);
+  // (the coarser run's results are host values: back where the launches run)
+  Field<real> coarse_load = C.interior_load, coarse_body = C.u_full;
+  coarse_load.move_to(launch_space());
+  coarse_body.move_to(launch_space());
+  prolongate_slabs(C.slab, coarse_load.data(), fine, start.load_guess.data(), comm);
+  prolongate_slabs(C.slab, coarse_body.data(), fine, start.body.data(), comm);
   newton.body0 = &start.body;
 }
 
@@ -91,10 +96,11 @@ void show_iterates(const SteklovPoincare& S, const RunOptions& opt, RunResult& R
   newton.progress = [S = &S, R = &R, done = opt.iterate_done, rows, shown = newton.progress,
                      step = 0](const NewtonProgress& pr) mutable {
     if (shown) shown(pr);
-    std::vector<real> r(pr.u->size());
-    Field<real> u_full(S->full_size());
-    S->residual(pr.u->data(), r.data(), 1e-8, u_full.data());
+    const Field<real> u_placed = placed_field<real>(*pr.u);
+    Field<real> r(pr.u->size()), u_full(S->full_size());
+    S->residual(u_placed.data(), r.data(), 1e-8, u_full.data());
     S->exchange_ghosts(u_full.data());
+    u_full.move_to(Space::host);  // (an output)
     const std::vector<real> u = S->whole(*pr.u, 3), lambda = S->whole(*pr.lambda, 1), rw = S->whole(*pr.r, 3),
                             phi = S->whole(*pr.phi, 1);
     const std::vector<std::uint8_t> status = S->whole(*pr.status);
@@ -147,12 +153,18 @@ void choose_initial_iterate(const SteklovPoincare& S, const RunOptions& opt, con
   auto merit = [&](const std::vector<real>& u, const std::vector<real>& lambda, Field<real>& b,
                    std::vector<real>& r, bool warm) {
     const index p = S.contact_nodes();
+    b.resize(S.full_size());
+    {  // the solve where the launches run, the merit of its result on the host
+      const Field<real> u_placed = placed_field<real>(u);
+      Field<real> r_placed(3 * p);
+      const SolveStats st_r =
+          S.residual(u_placed.data(), r_placed.data(), choice_rtol, b.data(), warm ? b.data() : nullptr);
+      R.choice_fine_matvecs += S.apply_work(st_r.iterations);
+      r = r_placed.to_vector();
+    }
+    HostLaunches host;
     std::vector<real> v(4 * p), w(4 * p), d(3 * p);
     std::vector<std::uint8_t> st(p);
-    r.resize(3 * p);
-    b.resize(S.full_size());
-    const SolveStats st_r = S.residual(u.data(), r.data(), choice_rtol, b.data(), warm ? b.data() : nullptr);
-    R.choice_fine_matvecs += S.apply_work(st_r.iterations);
     ContactConditions l = law;
     if (opt.friction.is_coulomb()) l.set_coulomb_bound(opt.friction.F, lambda);
     const ResidualNorms n = approximation_step(p, l.law(newton.kink_contact), nullptr, units.data(), u.data(),
@@ -185,7 +197,7 @@ SolveStats scale_of_load(const SteklovPoincare& S, const RunOptions& opt, Newton
                          RunResult& R) {
   SolveStats cond;
   if (newton.u0 || opt.keep_interior_load) {
-    std::vector<real> btilde;
+    Field<real> btilde;
     cond = S.condensed_load(opt.scale_rtol, btilde, opt.keep_interior_load ? &R.interior_load : nullptr,
                             start.load_guess.empty() ? nullptr : start.load_guess.data());
     newton.force_scale = std::sqrt(S.sum(dot(index(btilde.size()), btilde.data(), btilde.data())));
@@ -298,6 +310,9 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
     R.u_full = std::move(body);
     S.exchange_ghosts(R.u_full.data());  // its ghost rows too (output pieces)
   }
+  // the results are host values (outputs; a coarser mesh's move back)
+  R.u_full.move_to(Space::host);
+  R.interior_load.move_to(Space::host);
   const double t4 = wall_time();
   if (opt.phase_done) opt.phase_done("final check and recovery", t4 - t3);
   R.times.nested = t0s - t0;

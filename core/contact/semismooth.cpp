@@ -8,6 +8,7 @@
 #include <string>
 
 #include "kernels/contact_maps.hpp"
+#include "kernels/launch.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/contact/boundary_preconditioner.hpp"
 #include "core/solvers/gmres.hpp"
@@ -52,24 +53,34 @@ struct InnerWork {
   }
 };
 
-// The reduced Newton system of one step (method.md §4).
+// The reduced Newton system of one step (method.md §4), where the launches run.
 struct ReducedSystem {
   explicit ReducedSystem(index n3)
       : known(n3), h(n3), rhs(n3), dlambda(n3 / 3), coupling(2 * (n3 / 3)), fixed(n3), free(n3) {}
-  std::vector<real> known;  // known increments: Δu_τ = v_12 (sticking), Δu_z = v_4 / s (contact)
-  std::vector<real> h;      // H_1 blocks (h11 | h12 | h22) of sliding nodes
-  std::vector<real> rhs;    // r_F: (s I + H_1) v_12 on sliding rows, v_3 + v_4 on separated u_z rows
-  std::vector<real> dlambda;  // Δλ = v_4 (separated), −v_3 (contact: plus (S Δu)_z)
+  Field<real> known;  // known increments: Δu_τ = v_12 (sticking), Δu_z = v_4 / s (contact)
+  Field<real> h;      // H_1 blocks (h11 | h12 | h22) of sliding nodes
+  Field<real> rhs;    // r_F: (s I + H_1) v_12 on sliding rows, v_3 + v_4 on separated u_z rows
+  Field<real> dlambda;  // Δλ = v_4 (separated), −v_3 (contact: plus (S Δu)_z)
   // Coulomb Newton: F t per sliding contact node (2 blocks of p; t = d_12/|d_12|),
   // the τ rows' coefficient of (S Δu)_z; zero on all other nodes
-  std::vector<real> coupling;
+  Field<real> coupling;
   bool coupled = false;
-  std::vector<std::uint8_t> fixed, free;  // per dof: increment known / part of F
+  Field<std::uint8_t> fixed, free;  // per dof: increment known / part of F
+};
+
+// One point x = (u, lambda) of the iteration with r = S u - b̃, its bound
+// and its approximation step (contact_maps.hpp), where the launches run.
+struct Point {
+  Field<real> u, lambda, r;    // 3p, p, 3p
+  Field<real> phi;             // its Tresca bound (Coulomb: from this point's lambda)
+  Field<real> v, w, d;         // v̂ (4p), w (4p), d (3p)
+  Field<std::uint8_t> status;  // p
+  explicit Point(index p) : u(3 * p), lambda(p), r(3 * p), phi(p), v(4 * p), w(4 * p), d(3 * p), status(p) {}
 };
 
 // Fills L from the node status and the approximation step d at scale s
-// (contact_maps.hpp): with v_12 = d_12 − u_τ, v_4 = d_4 − lambda the scaled
-// step's increments and v_3 = v̂_3, the linearisation of (8) at (x, d̂) gives
+// (contact_maps.hpp) of x: with v_12 = d_12 − u_τ, v_4 = d_4 − lambda the
+// scaled step's increments and v_3 = v̂_3, the linearisation of (8) at (x, d̂) gives
 //   sticking: Δu_τ = v_12;  sliding: (S Δu)_τ + H_1 Δu_τ = (s I + H_1) v_12
 //   contact: Δu_z = v_4 / s;  separated: Δλ = v_4, (S Δu)_z = v_3 + v_4
 // (s = 1: the paper's (G A + H) Δ = (G + H) v̂). Returns whether any known
@@ -83,52 +94,69 @@ struct ReducedSystem {
 // λ_new = λ + Δλ with Δλ = (S Δu)_z − v_3: a coupling to the z row of S Δu
 // (L.coupling) and a known term. Separated nodes have phi = F d_4 = 0 and
 // stay uncoupled.
-bool linearise(index p, const ContactConditions& law, const real* scale, const std::vector<real>& u,
-               const std::vector<real>& lambda, const std::vector<std::uint8_t>& status, const std::vector<real>& vhat,
-               const std::vector<real>& d, const FrictionLaw& friction, ReducedSystem& L) {
-  bool any_known = false;
+bool linearise(index p, const real* scale, const Point& x, const FrictionLaw& friction, ReducedSystem& L) {
   L.coupled = friction.differentiates_bound();
-  for (index i = 0; i < p; ++i) {
+  const bool coupled = L.coupled;
+  const real F = friction.F;
+  const real *u = x.u.data(), *lambda = x.lambda.data(), *vhat = x.v.data(), *d = x.d.data(), *phi = x.phi.data();
+  const std::uint8_t* status = x.status.data();
+  real *known = L.known.data(), *h = L.h.data(), *rhs = L.rhs.data(), *dlambda = L.dlambda.data(),
+       *coupling = L.coupling.data();
+  std::uint8_t *fixed = L.fixed.data(), *free = L.free.data();
+  for_each_entry(p, Cost{81, 30}, [=](index i) {
     const bool stick = status[i] & kStick, contact = status[i] & kContact;
     const real s = scale ? scale[i] : 1;
     const real v1 = d[i] - u[i], v2 = d[p + i] - u[p + i], v3 = vhat[2 * p + i], v4 = d[2 * p + i] - lambda[i];
-    L.fixed[i] = L.fixed[p + i] = stick;
-    L.fixed[2 * p + i] = contact;
-    L.free[i] = L.free[p + i] = !stick;
-    L.free[2 * p + i] = !contact;
+    fixed[i] = fixed[p + i] = stick;
+    fixed[2 * p + i] = contact;
+    free[i] = free[p + i] = !stick;
+    free[2 * p + i] = !contact;
     real h11 = 0, h12 = 0, h22 = 0;
-    if (!stick) sliding_block(law.phi[i], d[i], d[p + i], h11, h12, h22);
-    L.h[i] = h11;
-    L.h[p + i] = h12;
-    L.h[2 * p + i] = h22;
-    L.known[i] = stick ? v1 : 0;
-    L.known[p + i] = stick ? v2 : 0;
-    L.known[2 * p + i] = contact ? v4 / s : 0;
-    L.dlambda[i] = contact ? -v3 : v4;  // + (S Δu)_z on contact nodes, after the solve
-    L.rhs[i] = stick ? 0 : s * v1 + h11 * v1 + h12 * v2;
-    L.rhs[p + i] = stick ? 0 : s * v2 + h12 * v1 + h22 * v2;
-    L.rhs[2 * p + i] = contact ? 0 : v3 + v4;
-    L.coupling[i] = L.coupling[p + i] = 0;
-    if (L.coupled && !stick && contact) {
+    if (!stick) sliding_block(phi[i], d[i], d[p + i], h11, h12, h22);
+    h[i] = h11;
+    h[p + i] = h12;
+    h[2 * p + i] = h22;
+    known[i] = stick ? v1 : 0;
+    known[p + i] = stick ? v2 : 0;
+    known[2 * p + i] = contact ? v4 / s : 0;
+    dlambda[i] = contact ? -v3 : v4;  // + (S Δu)_z on contact nodes, after the solve
+    real r1 = stick ? 0 : s * v1 + h11 * v1 + h12 * v2;
+    real r2 = stick ? 0 : s * v2 + h12 * v1 + h22 * v2;
+    rhs[2 * p + i] = contact ? 0 : v3 + v4;
+    coupling[i] = coupling[p + i] = 0;
+    if (coupled && !stick && contact) {
       const real n = std::hypot(d[i], d[p + i]);
-      const real tx = friction.F * d[i] / n, ty = friction.F * d[p + i] / n;
+      const real tx = F * d[i] / n, ty = F * d[p + i] / n;
       const real dl = -v3 - v4;  // the known part of λ_new − d_4
-      L.rhs[i] -= tx * dl;
-      L.rhs[p + i] -= ty * dl;
-      L.coupling[i] = tx;
-      L.coupling[p + i] = ty;
+      r1 -= tx * dl;
+      r2 -= ty * dl;
+      coupling[i] = tx;
+      coupling[p + i] = ty;
     }
-    any_known = any_known || L.known[i] != 0 || L.known[p + i] != 0 || L.known[2 * p + i] != 0;
-  }
-  return any_known;
+    rhs[i] = r1;
+    rhs[p + i] = r2;
+  });
+  const real nodes_known = sum_over_entries(p, Cost{24, 0}, [=](index i) {
+    return real(known[i] != 0 || known[p + i] != 0 || known[2 * p + i] != 0);
+  });
+  return nodes_known > 0;
 }
 
-// y_τ += F t (S x)_z on sliding contact nodes (Coulomb Newton)
-void add_coupling(const ReducedSystem& L, index p, const real* Sx, real* y) {
-  for (index i = 0; i < p; ++i) {
-    y[i] += L.coupling[i] * Sx[2 * p + i];
-    y[p + i] += L.coupling[p + i] * Sx[2 * p + i];
-  }
+// rhs -= mask_F (S Δu_known (+ F t (S Δu_known)_z: Coulomb Newton)), with
+// Sk = S Δu_known: the known increments' part of the right-hand side
+void subtract_known(const ReducedSystem& L, index p, const real* Sk, real* rhs) {
+  const real* coupling = L.coupling.data();
+  const std::uint8_t* free = L.free.data();
+  const bool coupled = L.coupled;
+  for_each_entry(p, Cost{67, 5}, [=](index i) {
+    for (int a = 0; a < 3; ++a) {
+      const index k = a * p + i;
+      if (!free[k]) continue;
+      real y = rhs[k] - Sk[k];
+      if (coupled && a < 2) y -= coupling[k] * Sk[2 * p + i];
+      rhs[k] = y;
+    }
+  });
 }
 
 // y = mask_F (S x + H x (+ F t (S x)_z: Coulomb Newton)), with the side
@@ -146,8 +174,8 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
   void set_inner_rtol(real r) { rtol_ = r; }
   void apply(const real* x, real* y, real* side) const override { apply(x, y, side, side + S_.size()); }
   void apply(const real* x, real* y) const override {
-    std::vector<real> Sx(S_.size());  // (GMRES: no side product, so no 3D extension either)
-    apply(x, y, Sx.data(), nullptr);
+    Sx_.resize(S_.size());  // (GMRES: no side product, so no 3D extension either)
+    apply(x, y, Sx_.data(), nullptr);
   }
 
  private:
@@ -155,21 +183,28 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
   void apply(const real* x, real* y, real* Sx, real* extension) const {
     work_.apply(S_, x, Sx, rtol_, extension);
     const index p = S_.size() / 3;
-    const real* h = L_.h.data();
-    for (index i = 0; i < p; ++i) {
-      y[i] = Sx[i] + h[i] * x[i] + h[p + i] * x[p + i];
-      y[p + i] = Sx[p + i] + h[p + i] * x[i] + h[2 * p + i] * x[p + i];
-      y[2 * p + i] = Sx[2 * p + i];
-    }
-    if (L_.coupled) add_coupling(L_, p, Sx, y);
-    for (index i = 0; i < 3 * p; ++i)
-      if (!L_.free[i]) y[i] = 0;
+    const real *h = L_.h.data(), *coupling = L_.coupling.data();
+    const std::uint8_t* free = L_.free.data();
+    const bool coupled = L_.coupled;
+    for_each_entry(p, Cost{123, 12}, [=](index i) {
+      real y1 = Sx[i] + h[i] * x[i] + h[p + i] * x[p + i];
+      real y2 = Sx[p + i] + h[p + i] * x[i] + h[2 * p + i] * x[p + i];
+      const real y3 = Sx[2 * p + i];
+      if (coupled) {
+        y1 += coupling[i] * y3;
+        y2 += coupling[p + i] * y3;
+      }
+      y[i] = free[i] ? y1 : 0;
+      y[p + i] = free[p + i] ? y2 : 0;
+      y[2 * p + i] = free[2 * p + i] ? y3 : 0;
+    });
   }
 
   const SteklovPoincare& S_;
   const ReducedSystem& L_;
   InnerWork& work_;
   real rtol_ = 1e-12;
+  mutable Field<real> Sx_;
 };
 
 // The result of solving one reduced Newton system.
@@ -184,7 +219,7 @@ struct StepOutcome {
 // absolute `floor`; side gets the CG's running estimates [S Δu | E Δu] of the
 // whole step (known increments included; inexact; GMRES: the known part only).
 StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreconditioner* M, real eta, real floor,
-                       real s_bound, bool any_known, InnerWork& work, CGWorkspace& ws, std::vector<real>& du,
+                       real s_bound, bool any_known, InnerWork& work, CGWorkspace& ws, Field<real>& du,
                        Field<real>& side, Field<real>& known_side) {
   const index n3 = S.size(), nf = S.full_size();
   real* scratch = known_side.data();  // S Δu_known, then E Δu_known
@@ -207,16 +242,9 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
       out.inner_failed = true;
       return out;
     }
-    for (index i = 0; i < n3; ++i)
-      if (L.free[i]) L.rhs[i] -= scratch[i];
-    if (L.coupled) {  // ... and its F t (S Δu_known)_z on the coupled rows
-      std::vector<real> c(n3, 0.0);
-      add_coupling(L, n3 / 3, scratch, c.data());
-      for (index i = 0; i < n3; ++i)
-        if (L.free[i]) L.rhs[i] -= c[i];
-    }
+    subtract_known(L, n3 / 3, scratch, L.rhs.data());
   } else {
-    std::fill(known_side.begin(), known_side.end(), 0.0);
+    fill<real>(n3 + nf, 0, scratch);
   }
   if (M) M->update(L.h, L.fixed, L.free);
   ReducedNewtonOperator A(S, L, work);
@@ -245,7 +273,7 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
     go.reduction = co.reduction;
     ScopedTimer t(Kernel::outer_cg);
     out.outer = gmres(A, M, L.rhs.data(), du.data(), go);
-    std::fill(side.begin(), side.end(), 0.0);
+    fill<real>(n3 + nf, 0, side.data());
   } else {
     ScopedTimer t(Kernel::outer_cg);
     out.outer = pcg(A, M, L.rhs.data(), du.data(), side.data(), co, ws);
@@ -320,12 +348,15 @@ real forcing_term(const NewtonOptions& opt, int k, real vnorm, real previous, re
   return std::min(opt.forcing_max, std::max(eta_k, real(0.1) * tol / vnorm));
 }
 
-// the progress of iteration k to the caller: states counted over all ranks
-void report_progress(const SteklovPoincare& S, const NewtonResult& R, const ContactConditions& law, int k, real vnorm,
+// the progress of iteration k to the caller: states counted over all ranks,
+// the iterate in host copies (p-sized: once per Newton step)
+void report_progress(const SteklovPoincare& S, const NewtonResult& R, const Point& x, int k, real vnorm,
                      long long inner, double seconds, const std::function<void(const NewtonProgress&)>& progress) {
-  const StateCounts c = count_states(S.contact_nodes(), R.status.data());
-  NewtonProgress pr{k, vnorm, 0, 0, 0, 0, inner, R.outer_iterations, seconds,
-                    &R.u, &R.lambda, &R.r, &R.status, &law.phi};
+  const StateCounts c = count_states(S.contact_nodes(), x.status.data());
+  const std::vector<real> u = x.u.to_vector(), lambda = x.lambda.to_vector(), r = x.r.to_vector(),
+                          phi = x.phi.to_vector();
+  const std::vector<std::uint8_t> status = x.status.to_vector();
+  NewtonProgress pr{k, vnorm, 0, 0, 0, 0, inner, R.outer_iterations, seconds, &u, &lambda, &r, &status, &phi};
   pr.separated = index(S.sum(real(c.separated)));
   pr.sticking = index(S.sum(real(c.stick)));
   pr.sliding = index(S.sum(real(c.slip)));
@@ -347,26 +378,18 @@ real line_search(const std::vector<real>& merits, int memory, int halvings, cons
 }
 
 // One semismooth* Newton solve (semismooth_newton): its state and its steps.
+// Every vector of the iteration lives where the launches run; the options'
+// initial values come in, and the result's values go out, as host copies.
 class NewtonSolve {
  public:
   NewtonSolve(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt);
   NewtonResult run();
 
  private:
-  // the scratch of one evaluation of the approximation step (a trial point
-  // of the line search has its own law: Coulomb's bound of a rejected trial
-  // must not outlive it)
-  struct Point {
-    std::vector<real> u, lambda, r, v, w, d;
-    std::vector<std::uint8_t> status;
-    ContactConditions law;
-  };
   NewtonResult finish(NewtonReason reason);
   bool start();
   bool refresh(real rtol);
-  ResidualNorms residual_at(ContactConditions& at, const std::vector<real>& u, const std::vector<real>& lambda,
-                            const std::vector<real>& r, std::vector<real>& vv, std::vector<real>& dd,
-                            std::vector<std::uint8_t>& st);
+  ResidualNorms residual_at(Point& at);
   bool measure(int k);
   std::optional<NewtonReason> record(int k);
   std::optional<NewtonReason> newton_step();
@@ -374,20 +397,20 @@ class NewtonSolve {
 
   const SteklovPoincare& S;
   const NewtonOptions& opt;
-  ContactConditions law;
   const double t0;
   const index p, n3, nf;
   InnerWork work;
   NewtonResult R;
   real fscale = 1;  // |b̃|
   real r_err = 0;   // bounds the error of the current r
-  const real* scale_ptr = nullptr;  // the step's metric (nullptr: the paper's s = 1)
-  const real* units = nullptr;      // the diagonal metric of the residual in consistent units
-  Point trial;
+  Field<real> gap;              // the law's gaps
+  Field<real> scale, units;     // the step's metric (empty: the paper's s = 1) and the consistent units'
+  const real* scale_ptr = nullptr;
+  // the iterate x, and a trial point of the line search (its own bound:
+  // Coulomb's bound of a rejected trial must not outlive it)
+  Point x, trial;
   // side: [S Δu | E Δu] of the step; known_side: the same of its known increments
-  std::vector<real> v, d, du;
-  Field<real> side, known_side;
-  std::vector<real> dlambda;
+  Field<real> du, side, known_side, dlambda;
   ReducedSystem L;
   std::unique_ptr<BoundaryPreconditioner> M;
   CGWorkspace ws;
@@ -401,13 +424,12 @@ class NewtonSolve {
 NewtonSolve::NewtonSolve(const SteklovPoincare& S_, const ContactConditions& given, const NewtonOptions& opt_)
     : S(S_),
       opt(opt_),
-      law(given),
       t0(wall_time()),
       p(S_.size() / 3),
       n3(3 * p),
       nf(S_.full_size()),
-      v(4 * p),
-      d(3 * p),
+      x(p),
+      trial(p),
       du(n3),
       side(n3 + nf),
       known_side(n3 + nf),
@@ -417,30 +439,31 @@ NewtonSolve::NewtonSolve(const SteklovPoincare& S_, const ContactConditions& giv
   // Coulomb: the bound follows lambda at every iteration
   if (opt.friction.is_coulomb() && !opt.friction.bound_follows_lambda())
     throw std::invalid_argument("semismooth_newton: a Coulomb fixed point runs whole Tresca solves (coulomb.hpp)");
-  check_inputs(p, nf, law, opt);
-  R.u.assign(n3, 0);
-  R.lambda.assign(p, 0);
-  R.r.assign(n3, 0);
-  R.status.assign(p, 0);
+  check_inputs(p, nf, given, opt);
+  x.phi = placed_field<real>(given.phi);
+  trial.phi = x.phi;
+  gap = placed_field<real>(given.gap);
   // the approximation step's metric (contact_maps.hpp): the paper's (s = 1) or
   // s_i = mean diagonal of K_cc at contact node i; kept in the result for
-  // the final report's status
+  // the final report's status. The residual in consistent units is measured
+  // in the stiffness of the diagonal metric whatever the step's metric.
   R.units = step_scale(S);
   R.stop = opt.stop;
   R.kink_contact = opt.kink_contact;
-  if (opt.scaling == StepScaling::diagonal) R.scale = R.units;
-  scale_ptr = R.scale.empty() ? nullptr : R.scale.data();
-  // the residual in consistent units is measured in the stiffness of the
-  // diagonal metric whatever the step's metric
-  units = R.units.data();
-  if (opt.u0) R.u = *opt.u0;
-  if (opt.lambda0) R.lambda = *opt.lambda0;
-  if (opt.body0)
+  units = placed_field<real>(R.units);
+  if (opt.scaling == StepScaling::diagonal) {
+    R.scale = R.units;
+    scale = units;
+    scale_ptr = scale.data();
+  }
+  if (opt.u0) x.u = placed_field<real>(*opt.u0);
+  if (opt.lambda0) x.lambda = placed_field<real>(*opt.lambda0);
+  if (opt.body0) {
     R.body = *opt.body0;
-  else
-    R.body.assign(nf, 0);
-  trial = Point{std::vector<real>(n3), std::vector<real>(p),    std::vector<real>(n3),         std::vector<real>(4 * p),
-                std::vector<real>(4 * p), std::vector<real>(3 * p), std::vector<std::uint8_t>(p), law};
+    R.body.move_to(launch_space());
+  } else {
+    R.body = Field<real>(nf);
+  }
   if (opt.outer_pc == OuterPreconditioner::multigrid)
     M = std::make_unique<BoundaryPreconditioner>(S, S.mg_options());
   // S <= K_cc, whose largest eigenvalue is below 4 times its largest
@@ -452,7 +475,11 @@ NewtonSolve::NewtonSolve(const SteklovPoincare& S_, const ContactConditions& giv
 
 NewtonResult NewtonSolve::finish(NewtonReason reason) {
   R.reason = reason;
-  R.phi = law.phi;
+  R.u = x.u.to_vector();
+  R.lambda = x.lambda.to_vector();
+  R.r = x.r.to_vector();
+  R.status = x.status.to_vector();
+  R.phi = x.phi.to_vector();
   R.inner_iterations = work.iterations;
   R.fine_matvecs = work.fine_matvecs;
   return std::move(R);
@@ -462,17 +489,17 @@ NewtonResult NewtonSolve::finish(NewtonReason reason) {
 // from the body
 bool NewtonSolve::refresh(real rtol) {
   R.operator_applications += 1;
-  return work.residual(S, R.u.data(), R.r.data(), std::max(rtol, real(1e-12)), R.body.data(), R.body.data());
+  return work.residual(S, x.u.data(), x.r.data(), std::max(rtol, real(1e-12)), R.body.data(), R.body.data());
 }
 
 // the first residual and |b̃| (given, or from x0 = 0, where r0 = -b̃; 1 if
 // there is no load at all)
 bool NewtonSolve::start() {
   if (opt.r0)
-    R.r = *opt.r0;
+    x.r = placed_field<real>(*opt.r0);
   else if (!refresh(opt.initial_residual_rtol))
     return false;
-  R.force_scale = opt.force_scale > 0 ? opt.force_scale : std::sqrt(S.sum(dot(n3, R.r.data(), R.r.data())));
+  R.force_scale = opt.force_scale > 0 ? opt.force_scale : std::sqrt(S.sum(dot(n3, x.r.data(), x.r.data())));
   if (!(R.force_scale > 0)) R.force_scale = 1;
   fscale = R.force_scale;
   r_err = (opt.r0 ? (opt.r0_accuracy > 0 ? opt.r0_accuracy : opt.residual_accuracy) : opt.initial_residual_rtol) *
@@ -480,14 +507,13 @@ bool NewtonSolve::start() {
   return true;
 }
 
-// the approximation step at (u, lambda, r) with the bound of `at` (Coulomb:
-// phi_i = F lambda_i of that iterate): v̂, d and status into the given arrays
-ResidualNorms NewtonSolve::residual_at(ContactConditions& at, const std::vector<real>& u,
-                                       const std::vector<real>& lambda, const std::vector<real>& r,
-                                       std::vector<real>& vv, std::vector<real>& dd, std::vector<std::uint8_t>& st) {
-  if (opt.friction.bound_follows_lambda()) at.set_coulomb_bound(opt.friction.F, lambda);
-  return approximation_step(p, at.law(opt.kink_contact), scale_ptr, units, u.data(), lambda.data(), r.data(),
-                            vv.data(), trial.w.data(), dd.data(), st.data());
+// the approximation step at the point's (u, lambda, r) with its bound
+// (Coulomb: phi_i = F lambda_i of that point): its v̂, w, d and status
+ResidualNorms NewtonSolve::residual_at(Point& at) {
+  if (opt.friction.bound_follows_lambda()) coulomb_bound(p, opt.friction.F, at.lambda.data(), at.phi.data());
+  return approximation_step(p, ContactLaw{at.phi.data(), gap.data(), opt.kink_contact}, scale_ptr, units.data(),
+                            at.u.data(), at.lambda.data(), at.r.data(), at.v.data(), at.w.data(), at.d.data(),
+                            at.status.data());
 }
 
 // 1. the approximation step at x = (u, lambda), r = S u - b̃, and the step's
@@ -498,15 +524,18 @@ bool NewtonSolve::measure(int k) {
   for (int pass = 0;; ++pass) {
     {
       ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
-      const ResidualNorms norms = residual_at(law, R.u, R.lambda, R.r, v, d, R.status);
+      const ResidualNorms norms = residual_at(x);
       merit = std::sqrt(S.sum(norms.consistent));
       vnorm = opt.stop == StopRule::consistent ? merit : std::sqrt(S.sum(norms.paper));
       if (opt.friction.differentiates_bound()) {
         // the step's point on the Coulomb graph: its pressure d_4 sets the
         // bound of its friction force (v̂, the residual, stays at lambda)
-        for (index i = 0; i < p; ++i) law.phi[i] = opt.friction.F * d[2 * p + i];
-        approximation_step(p, law.law(opt.kink_contact), scale_ptr, units, R.u.data(), R.lambda.data(), R.r.data(),
-                           trial.v.data(), trial.w.data(), d.data(), R.status.data());
+        const real F = opt.friction.F;
+        const real* d4 = x.d.data() + 2 * p;
+        real* phi = x.phi.data();
+        for_each_entry(p, Cost{16, 1}, [=](index i) { phi[i] = F * d4[i]; });
+        approximation_step(p, ContactLaw{phi, gap.data(), opt.kink_contact}, scale_ptr, units.data(), x.u.data(),
+                           x.lambda.data(), x.r.data(), trial.v.data(), trial.w.data(), x.d.data(), x.status.data());
       }
     }
     tol = std::max(opt.eps, opt.rtol * (k == 0 ? vnorm : R.history[0]));
@@ -532,7 +561,7 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
   R.merit.push_back(merit);
   R.inner_history.push_back(work.iterations);
   R.outer_history.push_back(R.outer_iterations);
-  if (opt.progress) report_progress(S, R, law, k, vnorm, work.iterations, wall_time() - t0, opt.progress);
+  if (opt.progress) report_progress(S, R, x, k, vnorm, work.iterations, wall_time() - t0, opt.progress);
   if (!std::isfinite(vnorm)) return NewtonReason::non_finite;
   if (vnorm <= tol) return NewtonReason::converged;
   if (k >= opt.max_iterations) return NewtonReason::iteration_limit;
@@ -544,8 +573,7 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
 // 3. the reduced Newton system, by preconditioned CG on the boundary
 std::optional<NewtonReason> NewtonSolve::newton_step() {
   // (any rank's known increments make every rank apply S to them: S is collective)
-  const bool any_known =
-      S.max(linearise(p, law, scale_ptr, R.u, R.lambda, R.status, v, d, opt.friction, L) ? 1 : 0) > 0;
+  const bool any_known = S.max(linearise(p, scale_ptr, x, opt.friction, L) ? 1 : 0) > 0;
   const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * tol, smax, any_known, work, ws, du, side, known_side);
   R.outer_iterations += step.outer.iterations;
   R.operator_applications += step.outer.iterations + (step.known_applied ? 1 : 0);
@@ -569,7 +597,7 @@ std::optional<NewtonReason> NewtonSolve::newton_step() {
 // 5. the step's length: the non-monotone line search on the merit |w|
 // (NewtonOptions::line_search); r, lambda and u are linear along it.
 std::optional<NewtonReason> NewtonSolve::take_step() {
-  for (index i = 0; i < n3; ++i) du[i] += L.known[i];
+  axpy(n3, 1, L.known.data(), du.data());
   real* Sdu = side.data();
   real* Edu = side.data() + n3;
   const real accuracy = std::max(opt.residual_accuracy * fscale, opt.residual_fraction * eta * vnorm);
@@ -580,26 +608,34 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
   R.operator_applications += 1;
   if (!work.apply(S, du.data(), Sdu, inc_rtol, Edu, Edu)) return NewtonReason::inner_failure;
   r_err = std::max(r_err, accuracy);
-  for (index i = 0; i < p; ++i) dlambda[i] = L.dlambda[i] + ((R.status[i] & kContact) ? Sdu[2 * p + i] : 0);
+  {  // Δλ: the known part, plus (S Δu)_z on contact nodes
+    const real* known_part = L.dlambda.data();
+    const std::uint8_t* status = x.status.data();
+    real* dl = dlambda.data();
+    for_each_entry(p, Cost{25, 1}, [=](index i) { dl[i] = known_part[i] + ((status[i] & kContact) ? Sdu[2 * p + i] : 0); });
+  }
 
   real alpha = 1;
   if (opt.line_search) {
     alpha = line_search(R.merit, opt.line_search_memory, opt.line_search_halvings, [&](real a) {
-      for (index i = 0; i < n3; ++i) {
-        trial.u[i] = R.u[i] + a * du[i];
-        trial.r[i] = R.r[i] + a * Sdu[i];
-      }
-      for (index i = 0; i < p; ++i) trial.lambda[i] = R.lambda[i] + a * dlambda[i];
+      const real *u = x.u.data(), *r = x.r.data(), *lambda = x.lambda.data(), *dU = du.data(), *dl = dlambda.data();
+      real *tu = trial.u.data(), *tr = trial.r.data(), *tl = trial.lambda.data();
+      for_each_entry(p, Cost{128, 14}, [=](index i) {
+        for (int c = 0; c < 3; ++c) {
+          tu[c * p + i] = u[c * p + i] + a * dU[c * p + i];
+          tr[c * p + i] = r[c * p + i] + a * Sdu[c * p + i];
+        }
+        tl[i] = lambda[i] + a * dl[i];
+      });
       ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
-      return std::sqrt(
-          S.sum(residual_at(trial.law, trial.u, trial.lambda, trial.r, trial.v, trial.d, trial.status).consistent));
+      return std::sqrt(S.sum(residual_at(trial).consistent));
     });
     if (alpha == 0) return NewtonReason::stagnation;
   }
   R.step_lengths.push_back(alpha);
-  axpy(p, alpha, dlambda.data(), R.lambda.data());
-  axpy(n3, alpha, du.data(), R.u.data());
-  axpy(n3, alpha, Sdu, R.r.data());
+  axpy(p, alpha, dlambda.data(), x.lambda.data());
+  axpy(n3, alpha, du.data(), x.u.data());
+  axpy(n3, alpha, Sdu, x.r.data());
   axpy(nf, alpha, Edu, R.body.data());
   return std::nullopt;
 }
@@ -616,6 +652,11 @@ NewtonResult NewtonSolve::run() {
 }
 
 }  // namespace
+
+void ContactConditions::set_coulomb_bound(real F, const std::vector<real>& lambda) {
+  HostLaunches host;  // (host values)
+  coulomb_bound(index(phi.size()), F, lambda.data(), phi.data());
+}
 
 NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& given, const NewtonOptions& opt) {
   return NewtonSolve(S, given, opt).run();

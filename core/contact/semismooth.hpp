@@ -191,10 +191,8 @@ struct ContactConditions {
   std::vector<real> phi, gap;
   static ContactConditions uniform(index p, real phi, real gap) { return {std::vector<real>(p, phi), std::vector<real>(p, gap)}; }
   ContactLaw law(bool kink_contact = true) const { return {phi.data(), gap.data(), kink_contact}; }
-  // Coulomb's bound at lambda: phi_i = F max(0, lambda_i)
-  void set_coulomb_bound(real F, const std::vector<real>& lambda) {
-    for (size_t i = 0; i < phi.size(); ++i) phi[i] = F * std::max(real(0), lambda[i]);
-  }
+  // Coulomb's bound at lambda (p host values): phi_i = F max(0, lambda_i)
+  void set_coulomb_bound(real F, const std::vector<real>& lambda);
 };
 
 // s_i = (K_xx + K_yy + K_zz)/3 at contact node i [N/m]: the diagonal of S

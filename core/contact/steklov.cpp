@@ -36,31 +36,21 @@ SteklovPoincare::~SteklovPoincare() = default;
 // the contact face's nodes in a 3D vector of box g: node c (this rank's
 // c - c_begin) is ix = 1 + c % ex, row c / ex - row0, iz = 0
 void SteklovPoincare::scatter(const real* vc, real* full) const {
-  const real* f = vc;
-  if (launch_space() != Space::host) {  // the contact values to where the launches run
-    face_.resize(3 * p_);
-    space_copy(launch_space(), face_.data(), Space::host, vc, 3 * p_ * sizeof(real));
-    f = face_.data();
-  }
   const index N = box().nodes(), nx = box().nx(), ex = P_.grid.ex, row0 = slab().y_begin - slab().lo, c0 = c_begin_,
               p = p_;
   for_each_entry(p, Cost{48, 0}, [=](index k) {
     const index c = c0 + k, n = 1 + c % ex + nx * (c / ex - row0);
-    for (int a = 0; a < 3; ++a) full[a * N + n] = f[a * p + k];
+    for (int a = 0; a < 3; ++a) full[a * N + n] = vc[a * p + k];
   });
 }
 
 void SteklovPoincare::gather(const real* full, real* vc) const {
-  const bool staged = launch_space() != Space::host;
-  if (staged) face_.resize(3 * p_);
-  real* f = staged ? face_.data() : vc;
   const index N = box().nodes(), nx = box().nx(), ex = P_.grid.ex, row0 = slab().y_begin - slab().lo, c0 = c_begin_,
               p = p_;
   for_each_entry(p, Cost{48, 0}, [=](index k) {
     const index c = c0 + k, n = 1 + c % ex + nx * (c / ex - row0);
-    for (int a = 0; a < 3; ++a) f[a * p + k] = full[a * N + n];
+    for (int a = 0; a < 3; ++a) vc[a * p + k] = full[a * N + n];
   });
-  if (staged) space_copy(Space::host, vc, launch_space(), f, 3 * p_ * sizeof(real));
 }
 
 real SteklovPoincare::sum(real local) const { return comm_.sum(local); }
@@ -97,10 +87,9 @@ std::vector<std::uint8_t> SteklovPoincare::whole(const std::vector<std::uint8_t>
 }
 
 std::vector<real> SteklovPoincare::contact_diagonal() const {
-  const Field<real>& d = K_.diagonal();
-  std::vector<real> dc(3 * p_);
-  gather(d.data(), dc.data());
-  return dc;
+  Field<real> dc(3 * p_);
+  gather(K_.diagonal().data(), dc.data());
+  return dc.to_vector();
 }
 
 void SteklovPoincare::apply_planes(real* x, real* y, index z_begin, index z_end) const {
@@ -145,12 +134,12 @@ SolveStats SteklovPoincare::residual(const real* u, real* r, real rtol, real* bo
   Field<real>& load = load_;
   load.resize(full_size());
   global_to_local(slab(), P_.load.data(), load.data());
-  std::vector<real> lc(3 * p_);
+  Field<real> lc(3 * p_);
   gather(load.data(), lc.data());
   zero_constrained(box(), mg_->op(0).faces(), load.data());
   K_.zero_ghosts(load.data());
   const SolveStats st = extend(u, load.data(), r, rtol, body, guess);
-  for (index i = 0; i < 3 * p_; ++i) r[i] -= lc[i];
+  axpy(3 * p_, -1, lc.data(), r);
   return st;
 }
 
@@ -182,14 +171,14 @@ double SteklovPoincare::apply_work(long long inner_iterations) const {
   return double(inner_iterations) * (1 + mg_->cycle_work()) + 2.0 / double(P_.grid.nz());
 }
 
-SolveStats SteklovPoincare::condensed_load(real rtol, std::vector<real>& b, Field<real>* interior,
+SolveStats SteklovPoincare::condensed_load(real rtol, Field<real>& b, Field<real>* interior,
                                            const real* guess) const {
   // b̃ = -(S 0 - b̃)
-  const std::vector<real> zero(3 * p_, 0.0);
-  b.resize(3 * p_);
+  const Field<real> zero(3 * p_);
+  b = Field<real>(3 * p_);
   if (interior) interior->resize(full_size());
   const SolveStats st = residual(zero.data(), b.data(), rtol, interior ? interior->data() : nullptr, guess);
-  for (real& x : b) x = -x;
+  scale(3 * p_, -1, b.data());
   return st;
 }
 

@@ -12,7 +12,10 @@
 // plane, K_ic v needs K only on plane iz = 1 and (K E v)_c only on iz = 0.
 //
 // DATA LAYOUT: contact vectors are SoA of 3 blocks of p values
-// [u_x(0..p-1) | u_y | u_z], contact node c as in problem.hpp.
+// [u_x(0..p-1) | u_y | u_z], contact node c as in problem.hpp. Every vector
+// argument, contact or 3D, lives where the launches run (kernels/launch.hpp:
+// device memory while the launches are on the device); the exceptions
+// return std::vector (host values: local_part, whole, contact_diagonal).
 // Cost per apply: one inner MG-CG solve (dominant) + 2 plane applies.
 //
 // Ranks: when the run has several MPI ranks and the grid is worth splitting
@@ -88,7 +91,7 @@ class SteklovPoincare {
   // for contact values u_c is then E u_c + K_ii^{-1} l_i: recovery costs no
   // solve beyond the final check's S u_c.
   // guess (3N): initial guess of K_ii^{-1} l_i.
-  SolveStats condensed_load(real rtol, std::vector<real>& b, Field<real>* interior = nullptr,
+  SolveStats condensed_load(real rtol, Field<real>& b, Field<real>* interior = nullptr,
                             const real* guess = nullptr) const;
 
   // the K_ii multigrid; its hierarchy() is shared with the Newton step's preconditioner
@@ -100,8 +103,7 @@ class SteklovPoincare {
   const Problem& problem() const { return P_; }
 
   // scatter contact values into / gather them from a full SoA grid vector
-  // (this rank's contact nodes and rows); the contact values in host
-  // memory, the grid vector where the launches run
+  // (this rank's contact nodes and rows)
   void scatter(const real* vc, real* full) const;
   void gather(const real* full, real* vc) const;
 
@@ -127,7 +129,6 @@ class SteklovPoincare {
   std::vector<int> counts_, displs_;           // every rank's contact nodes (whole())
   mutable CGWorkspace ws_;  // scratch
   mutable Field<real> w_, t_, z_, load_;  // load_: residual()'s l on this rank's rows
-  mutable Field<real> face_;              // contact values where the launches run (device: staged)
 };
 
 }  // namespace tresca
