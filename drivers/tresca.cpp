@@ -63,7 +63,11 @@ const char* kHelp =
     "  --mg-precision single|double  arithmetic of the multigrid V-cycles (default single;\n"
     "                     the Krylov solvers and all results are double either way)\n"
     "  --threads N        OpenMP threads (default: OMP_NUM_THREADS or all cores)\n"
-    "  --device cpu       where the kernels run: the CPU (the GPU: elastic --device gpu so far)\n"
+    "  --device cpu|gpu   where the kernels run (default cpu); gpu (a build with TRESCA_OFFLOAD,\n"
+    "                     one rank): every operator, multigrid level, Krylov and contact vector\n"
+    "                     in the GPU's memory for the whole solve; only scalars, the coarse\n"
+    "                     grid's solve, each Newton step's preconditioner set-up and the\n"
+    "                     outputs cross\n"
     "  --json FILE        write the run summary as one JSON object (rows with --table)\n"
     "  --contact-csv FILE one row per contact node\n"
     "  --vtk FILE.vtu     the body for ParaView: the undeformed mesh with the displacement u\n"
@@ -121,6 +125,7 @@ struct Command {
   ProblemSpec spec;
   RunOptions opt;
   int threads = 1;
+  std::string device = "cpu";  // where the kernels run (apply_device)
   std::string json_path, csv_path, vtk_path, table;
   std::vector<int> table_levels;
   VtkFormat vtk_format = VtkFormat::binary;
@@ -237,10 +242,7 @@ void check_outputs(const Command& c, const Comm& comm) {
 // at its own initial iterate); std::invalid_argument names what is wrong
 void parse_command(const Args& a, const Comm& comm, Command& c) {
   c.threads = apply_threads(a);
-  if (a.has("--device") && a.str("--device") != "cpu")
-    throw std::invalid_argument("--device " + a.str("--device") +
-                                ": the contact solve runs on the CPU only so far (issue 22: its contact-face "
-                                "vectors are not on the device yet); elastic --device gpu solves on the GPU");
+  c.device = apply_device(a, comm);
   c.table = a.str("--table");
   const bool table = !c.table.empty();
   if (table) {
@@ -388,7 +390,8 @@ void print_header(const Command& c, const ThreadPlacement& placement, const Comm
   std::printf("        estimated peak memory %.2f GB%s; kernels: %s; %s\n",
               estimated_memory_bytes_per_rank(spec, comm.size()) / 1e9, comm.distributed() ? " per rank" : "",
               build_info().c_str(), omp_wait_setting().c_str());
-  std::printf("        %s; %s\n", placement.describe().c_str(), huge_page_setting().c_str());
+  std::printf("        %s; %s; kernels on %s\n", placement.describe().c_str(), huge_page_setting().c_str(),
+              c.device.c_str());
 }
 
 // how the friction law's iteration ended (Coulomb)
@@ -460,8 +463,8 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
                 "%lld other collectives\n", cc.messages, cc.bytes / 1e6, cc.allreduces, cc.collectives);
   }
   if (c.profile)
-    std::printf("\nkernel profile (%s, %d threads)\n%s", build_info().c_str(), c.threads,
-                profile_table(R.times.total).c_str());
+    std::printf("\nkernel profile (%s, %d threads; kernels on %s)\n%s", build_info().c_str(), c.threads,
+                c.device.c_str(), profile_table(R.times.total).c_str());
 }
 
 // --vtk-every-iteration: each Newton iterate's files, into `out` and `steps`;

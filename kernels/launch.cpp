@@ -44,18 +44,52 @@ namespace {
 // The guard (TRESCA_DEVICE_GUARD=1 where no GPU is present): device memory
 // is mapped PROT_NONE and opened only while a target region or a copy runs,
 // so a host read or write through a device pointer (which the host fallback
-// would otherwise let pass) stops the program with SIGSEGV.
+// would otherwise let pass) stops the program with SIGSEGV. The device
+// blocks come from one reserved range, so opening and closing them is one
+// mprotect whatever their number (a contact solve has hundreds of Fields);
+// a freed block is emptied (its pages zero again) and reused by the next
+// block of its size.
 struct Guard {
   bool on = false;
   int open = 0;  // nesting depth of the regions running now
-  std::map<void*, std::size_t> blocks;
+  char* base = nullptr;
+  std::size_t reserved = std::size_t(64) << 30, used = 0;  // [base, base + used): blocks handed out so far
+  std::map<void*, std::size_t> blocks;                      // live blocks
+  std::multimap<std::size_t, void*> freed;                  // freed blocks by size
   Guard() {
     const char* e = std::getenv("TRESCA_DEVICE_GUARD");
     on = e && std::string(e) == "1" && omp_get_num_devices() == 0;
+    if (!on) return;
+    void* p = mmap(nullptr, reserved, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+    if (p == MAP_FAILED) throw std::runtime_error("device guard: cannot reserve its address range");
+    base = static_cast<char*>(p);
   }
   void protect(int prot) {
-    for (const auto& b : blocks)
-      if (mprotect(b.first, b.second, prot) != 0) throw std::runtime_error("device guard: mprotect failed");
+    if (used > 0 && mprotect(base, used, prot) != 0) throw std::runtime_error("device guard: mprotect failed");
+  }
+  void* allocate(std::size_t size) {
+    void* p;
+    auto it = freed.find(size);
+    if (it != freed.end()) {
+      p = it->second;
+      freed.erase(it);
+    } else {
+      if (used + size > reserved) throw std::bad_alloc();
+      p = base + used;
+      used += size;
+      // (fresh pages beyond the last protect: open them if a region runs now)
+      if (open && mprotect(p, size, PROT_READ | PROT_WRITE) != 0) throw std::runtime_error("device guard: mprotect failed");
+    }
+    blocks[p] = size;
+    return p;
+  }
+  bool release(void* p) {
+    auto it = blocks.find(p);
+    if (it == blocks.end()) return false;
+    madvise(p, it->second, MADV_DONTNEED);
+    freed.emplace(it->second, p);
+    blocks.erase(it);
+    return true;
   }
 };
 Guard& guard() {
@@ -69,13 +103,7 @@ std::size_t page_rounded(std::size_t bytes) {
 
 void* device_allocate(std::size_t bytes) {
   Guard& g = guard();
-  if (g.on) {
-    const std::size_t size = page_rounded(bytes);
-    void* p = mmap(nullptr, size, g.open ? PROT_READ | PROT_WRITE : PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (p == MAP_FAILED) throw std::bad_alloc();
-    g.blocks[p] = size;
-    return p;
-  }
+  if (g.on) return g.allocate(page_rounded(bytes));
   void* p = omp_target_alloc(bytes, device());
   if (!p && bytes) throw std::bad_alloc();
   return p;
@@ -83,12 +111,7 @@ void* device_allocate(std::size_t bytes) {
 
 void device_release(void* p) noexcept {
   Guard& g = guard();
-  auto it = g.on ? g.blocks.find(p) : g.blocks.end();
-  if (it != g.blocks.end()) {
-    munmap(p, it->second);
-    g.blocks.erase(it);
-    return;
-  }
+  if (g.on && g.release(p)) return;
   omp_target_free(p, device());
 }
 

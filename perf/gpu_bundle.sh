@@ -5,10 +5,10 @@
 # root:
 #   bash perf/gpu_bundle.sh [bundle-dir]          (default .gpu-bundle, git-ignored)
 # then, on the GPU machine, from the project root of the copy that travelled:
-#   bash .gpu-bundle/run.sh [benchmark regex]     (default: every Device benchmark)
-# which runs the device tests, the Device* benchmarks, roofline --device
-# gpu at level 13 and the elastic solve with --device gpu at levels 10, 12
-# and 13 against the host's.
+#   bash .gpu-bundle/run.sh [tests|bench|elastic|contact|large|all]
+# which runs the device tests, the Device* benchmarks (BENCH=regex), roofline
+# --device gpu at level 13, the elastic and the contact solves with --device
+# gpu against the host's, and the large levels (run.sh's own header).
 # The bundle's build has no MPI (fewer libraries to carry) and targets
 # x86-64-v3 (AVX2) for its host code: its host figures are not the CPU's best.
 set -euo pipefail
@@ -27,21 +27,65 @@ cp -L "$lib"/libgomp.so.1 "$lib"/libgomp-plugin-nvptx.so.1 "$out/lib/"
 cp -L "$(ldconfig -p | awk '/libbenchmark\.so\./ {print $NF; exit}')" "$out/lib/"
 cat > "$out/run.sh" <<'RUN'
 #!/usr/bin/env bash
-# The device checks and benchmarks of the bundle (perf/gpu_bundle.sh). A
-# run without a usable GPU fails (test Device.PresentWhereRequired: GCC 12
-# falls back to the host even with OMP_TARGET_OFFLOAD=MANDATORY).
+# The device checks and benchmarks of the bundle (perf/gpu_bundle.sh), in
+# stages that each fit a 10-minute command:
+#   run.sh tests    the device tests (a run without a usable GPU fails:
+#                   Device.PresentWhereRequired; GCC 12 falls back to the
+#                   host even with OMP_TARGET_OFFLOAD=MANDATORY)
+#   run.sh bench    the Device* benchmarks and roofline --device gpu at level 13
+#   run.sh elastic  the MG-CG solve, GPU then CPU, levels 10, 12, 13
+#   run.sh contact  tresca, GPU then CPU, levels 8 and 12 and Coulomb 0.8 at
+#                   level 10: the contact values' largest difference relative
+#                   to their largest value (issue 22: <= 1e-10)
+#   run.sh large    tresca --device gpu at levels 13, 14 and 15
+#   run.sh all      tests, bench, elastic, contact (about 10 minutes)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export OMP_TARGET_OFFLOAD=${OMP_TARGET_OFFLOAD:-MANDATORY} TRESCA_REQUIRE_DEVICE=1
+out=${OUT:-/tmp}
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader 2>/dev/null || echo "no nvidia-smi"
-"$here/test_device"
-"$here/bench_kernels" --benchmark_filter="${1:-Device}" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
-"$here/roofline" --level 13 --device gpu
-for level in 10 12 13; do
-  "$here/elastic" --level "$level" --device gpu
-  "$here/elastic" --level "$level"
-done
+# largest |a - b| over the columns ux, uy, uz, lambda of two contact CSVs,
+# relative to the largest |a| of each column
+compare() {
+  paste -d, "$1" "$2" | awk -F, 'NR == 1 { n = NF / 2; for (i = 1; i <= n; ++i) col[$i] = i; next }
+    { for (c in want) { i = col[c]; d = $i - $(i + n); if (d < 0) d = -d; a = $i < 0 ? -$i : $i;
+        if (d > diff[c]) diff[c] = d; if (a > big[c]) big[c] = a } }
+    BEGIN { want["ux"]; want["uy"]; want["uz"]; want["lambda"] }
+    END { worst = 0; for (c in want) { r = big[c] > 0 ? diff[c] / big[c] : diff[c]; printf "%s %.2e  ", c, r;
+          if (r > worst) worst = r } printf "-> largest %.2e (%s)\n", worst, worst <= 1e-10 ? "ok" : "ABOVE 1e-10" }'
+}
+contact() {  # level, then tresca options
+  local level=$1; shift
+  "$here/tresca" --level "$level" "$@" --device gpu --profile --contact-csv "$out/gpu_$level.csv" --json "$out/gpu_$level.json"
+  "$here/tresca" --level "$level" "$@" --quiet --contact-csv "$out/cpu_$level.csv" --json "$out/cpu_$level.json"
+  grep -o '"newton_iterations":[0-9]*' "$out/gpu_$level.json" "$out/cpu_$level.json" || true
+  echo "level $level $*: GPU against CPU: $(compare "$out/gpu_$level.csv" "$out/cpu_$level.csv")"
+}
+stage=${1:-all}
+if [[ $stage == tests || $stage == all ]]; then
+  "$here/test_device"
+fi
+if [[ $stage == bench || $stage == all ]]; then
+  "$here/bench_kernels" --benchmark_filter="${BENCH:-Device}" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+  "$here/roofline" --level 13 --device gpu
+fi
+if [[ $stage == elastic || $stage == all ]]; then
+  for level in 10 12 13; do
+    "$here/elastic" --level "$level" --device gpu
+    "$here/elastic" --level "$level"
+  done
+fi
+if [[ $stage == contact || $stage == all ]]; then
+  contact 8
+  contact 12
+  contact 10 --coulomb 0.8
+fi
+if [[ $stage == large ]]; then
+  for level in 13 14 15; do
+    "$here/tresca" --level "$level" --device gpu --profile --json "$out/gpu_$level.json"
+  done
+fi
 RUN
 chmod +x "$out/run.sh"
-echo "bundle: $out ($(du -sh "$out" | cut -f1)); on the GPU machine: bash $out/run.sh"
+echo "bundle: $out ($(du -sh "$out" | cut -f1)); on the GPU machine: bash $out/run.sh [stage]"

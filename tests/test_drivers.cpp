@@ -76,9 +76,10 @@ TEST(ElasticDriver, RejectsBadInputWithOneLineNamingTheValue) {
   expect_error("elastic --dims 4x0x3", "4x0x3");
   expect_error("elastic --dims axbxc", "axbxc");
   expect_error("elastic --device tpu", "tpu");
-  expect_error("tresca --device gpu", "CPU only so far");
+  expect_error("tresca --device tpu", "tpu");
 #ifndef TRESCA_OFFLOAD
   expect_error("elastic --device gpu", "-DTRESCA_OFFLOAD=ON");
+  expect_error("tresca --device gpu", "-DTRESCA_OFFLOAD=ON");
 #endif
   expect_error("elastic --level abc", "abc");
   expect_error("elastic --frobnicate", "--frobnicate");

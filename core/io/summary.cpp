@@ -9,6 +9,7 @@
 #include "core/io/cli.hpp"
 #include "core/io/output.hpp"
 #include "core/io/problem_file.hpp"
+#include "kernels/launch.hpp"
 #include "kernels/simd.hpp"
 
 namespace tresca {
@@ -72,6 +73,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                                 {"collectives", c.collectives}};
   }
   j["build"] = build_info();
+  j["device"] = launch_on_device() ? "gpu, " + device_description() : std::string("cpu");
   j["omp_wait"] = omp_wait_setting();
   j["huge_pages"] = huge_page_setting();
   {

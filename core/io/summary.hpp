@@ -1,7 +1,7 @@
 // The run-summary schema: one JSON object per solve, written by `tresca`
 // (--json; one per row with --table) and by `perf/scaling` (one per level and
 // thread count). Keys: level (null for --dims), dims, nodes, contact_nodes,
-// dofs, phi, eps, threads, build (ISA line), mg_precision, newton_iterations,
+// dofs, phi, eps, threads, build (ISA line), device (where the kernels ran), mg_precision, newton_iterations,
 // converged, reason, residual_history, final_residual, true_residual,
 // true_residual_relative, times {setup, condense, solve, recover, total},
 // counts {inner_iterations, outer_iterations, operator_applications,
