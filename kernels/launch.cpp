@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <map>
+#include <memory>
 
 #include <cstdlib>
 #include <cstring>
@@ -44,28 +45,28 @@ namespace {
 // The guard (TRESCA_DEVICE_GUARD=1 where no GPU is present): device memory
 // is mapped PROT_NONE and opened only while a target region or a copy runs,
 // so a host read or write through a device pointer (which the host fallback
-// would otherwise let pass) stops the program with SIGSEGV. The device
-// blocks come from one reserved range, so opening and closing them is one
-// mprotect whatever their number (a contact solve has hundreds of Fields);
-// a freed block is emptied (its pages zero again) and reused by the next
-// block of its size.
-struct Guard {
-  bool on = false;
-  int open = 0;  // nesting depth of the regions running now
+// would otherwise let pass) stops the program with SIGSEGV; and host Field
+// memory is closed while a target region runs, so a kernel that reads a
+// host array (an illegal address on a GPU) stops it too.
+//
+// Each side's blocks come from one reserved address range, so opening or
+// closing them is one mprotect whatever their number (a contact solve has
+// hundreds of Fields); a freed block is emptied (its pages zero again) and
+// reused by the next block of its size.
+struct Arena {
   char* base = nullptr;
   std::size_t reserved = std::size_t(64) << 30, used = 0;  // [base, base + used): blocks handed out so far
+  int prot = PROT_NONE;                                     // every block's protection now
   std::map<void*, std::size_t> blocks;                      // live blocks
   std::multimap<std::size_t, void*> freed;                  // freed blocks by size
-  Guard() {
-    const char* e = std::getenv("TRESCA_DEVICE_GUARD");
-    on = e && std::string(e) == "1" && omp_get_num_devices() == 0;
-    if (!on) return;
+  explicit Arena(int initial) : prot(initial) {
     void* p = mmap(nullptr, reserved, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
     if (p == MAP_FAILED) throw std::runtime_error("device guard: cannot reserve its address range");
     base = static_cast<char*>(p);
   }
-  void protect(int prot) {
-    if (used > 0 && mprotect(base, used, prot) != 0) throw std::runtime_error("device guard: mprotect failed");
+  void protect(int to) {
+    prot = to;
+    if (used > 0 && mprotect(base, used, to) != 0) throw std::runtime_error("device guard: mprotect failed");
   }
   void* allocate(std::size_t size) {
     void* p;
@@ -77,8 +78,7 @@ struct Guard {
       if (used + size > reserved) throw std::bad_alloc();
       p = base + used;
       used += size;
-      // (fresh pages beyond the last protect: open them if a region runs now)
-      if (open && mprotect(p, size, PROT_READ | PROT_WRITE) != 0) throw std::runtime_error("device guard: mprotect failed");
+      if (prot != PROT_NONE && mprotect(p, size, prot) != 0) throw std::runtime_error("device guard: mprotect failed");
     }
     blocks[p] = size;
     return p;
@@ -92,6 +92,18 @@ struct Guard {
     return true;
   }
 };
+struct Guard {
+  bool on = false;
+  int open = 0, launches = 0;  // nesting depth of the regions, and of the launches among them, running now
+  std::unique_ptr<Arena> device, host;
+  Guard() {
+    const char* e = std::getenv("TRESCA_DEVICE_GUARD");
+    on = e && std::string(e) == "1" && omp_get_num_devices() == 0;
+    if (!on) return;
+    device = std::make_unique<Arena>(PROT_NONE);
+    host = std::make_unique<Arena>(PROT_READ | PROT_WRITE);
+  }
+};
 Guard& guard() {
   static Guard g;
   return g;
@@ -103,7 +115,7 @@ std::size_t page_rounded(std::size_t bytes) {
 
 void* device_allocate(std::size_t bytes) {
   Guard& g = guard();
-  if (g.on) return g.allocate(page_rounded(bytes));
+  if (g.on) return g.device->allocate(page_rounded(bytes));
   void* p = omp_target_alloc(bytes, device());
   if (!p && bytes) throw std::bad_alloc();
   return p;
@@ -111,11 +123,12 @@ void* device_allocate(std::size_t bytes) {
 
 void device_release(void* p) noexcept {
   Guard& g = guard();
-  if (g.on && g.release(p)) return;
+  if (g.on && g.device->release(p)) return;
   omp_target_free(p, device());
 }
 
 void* host_allocate(std::size_t bytes) {
+  if (guard().on) return guard().host->allocate(page_rounded(bytes));
   if (bytes < kHugeFrom) return ::operator new(bytes);
   const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
   void* p = std::aligned_alloc(kHugePage, rounded);
@@ -139,6 +152,8 @@ void space_free(Space s, void* p, std::size_t bytes) noexcept {
   if (!p) return;
   if (s == Space::device)
     device_release(p);
+  else if (guard().on && guard().host->release(p))
+    return;
   else if (bytes < kHugeFrom)
     ::operator delete(p);
   else
@@ -151,7 +166,7 @@ void space_copy(Space to_space, void* to, Space from_space, const void* from, st
     std::memcpy(to, from, bytes);
     return;
   }
-  DeviceRegion region;
+  DeviceRegion region(true);
   if (omp_target_memcpy(to, from, bytes, 0, 0, device_of(to_space), device_of(from_space)) != 0)
     throw std::runtime_error(std::string("copying a field from the ") + to_string(from_space) + " to the " +
                              to_string(to_space) + " failed");
@@ -178,14 +193,18 @@ void space_zero(Space s, void* p, std::size_t bytes) {
 
 bool device_guarded() { return guard().on; }
 
-DeviceRegion::DeviceRegion() {
+DeviceRegion::DeviceRegion(bool copy) : copy_(copy) {
   Guard& g = guard();
-  if (g.on && g.open++ == 0) g.protect(PROT_READ | PROT_WRITE);
+  if (!g.on) return;
+  if (g.open++ == 0) g.device->protect(PROT_READ | PROT_WRITE);
+  if (!copy_ && g.launches++ == 0) g.host->protect(PROT_NONE);
 }
 
 DeviceRegion::~DeviceRegion() {
   Guard& g = guard();
-  if (g.on && --g.open == 0) g.protect(PROT_NONE);
+  if (!g.on) return;
+  if (!copy_ && --g.launches == 0) g.host->protect(PROT_READ | PROT_WRITE);
+  if (--g.open == 0) g.device->protect(PROT_NONE);
 }
 
 void field_read_on_host(Space s) {

@@ -63,14 +63,19 @@ class HostLaunches {
 
 // Every device launch and copy runs inside a DeviceRegion: where no GPU is
 // present and TRESCA_DEVICE_GUARD=1, device memory is open to the host
-// only meanwhile (the tests' check that a device solve never reads device
-// memory on the host); otherwise it costs nothing.
+// only meanwhile, and host Field memory is closed while a launch runs (the
+// tests' check that a device solve never reads device memory on the host,
+// nor host memory in a kernel: either would fail on a GPU and pass in the
+// host fallback); otherwise it costs nothing. A copy opens both.
 class DeviceRegion {
  public:
-  DeviceRegion();
+  explicit DeviceRegion(bool copy = false);
   ~DeviceRegion();
   DeviceRegion(const DeviceRegion&) = delete;
   DeviceRegion& operator=(const DeviceRegion&) = delete;
+
+ private:
+  bool copy_;
 };
 bool device_guarded();  // whether that guard is on
 

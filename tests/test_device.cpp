@@ -104,6 +104,22 @@ TEST(DeviceGuard, StopsAHostReadOfDeviceMemory) {
       "");
 }
 
+// ... and a kernel that reads host memory (an illegal address on a GPU)
+// stops it too, while the same kernel over device memory runs
+TEST(DeviceGuard, StopsAKernelReadOfHostMemory) {
+  const char* e = std::getenv("TRESCA_DEVICE_GUARD");
+  if (!e || std::string(e) != "1") GTEST_SKIP() << "TRESCA_DEVICE_GUARD unset";
+  if (omp_get_num_devices() > 0) GTEST_SKIP() << "a GPU is present: its memory guards itself";
+  if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device launches";
+  const Field<real> host{1, 2, 3};
+  OnDevice on;
+  const Field<real> x = on_device({1, 2, 3});
+  Field<real> y(3);
+  copy(3, x.data(), y.data());
+  EXPECT_EQ(y.to_vector()[2], 3);
+  EXPECT_DEATH(copy(3, host.data(), y.data()), "");
+}
+
 TEST(Device, VectorKernelsOnTheDeviceMatchTheHost) {
   if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
   std::printf("device: %s\n", device_description().c_str());

@@ -26,6 +26,13 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
     displs_[q] = int(ex * s.y_begin);
   }
   const index n = full_size();
+  // the load on this rank's rows (all of it on one rank): its contact part
+  // and its interior part, made once where the launches run
+  interior_load_ = local_rows(slab(), P.load.data());
+  contact_load_ = Field<real>(3 * p_);
+  gather(interior_load_.data(), contact_load_.data());
+  zero_constrained(box(), mg_->op(0).faces(), interior_load_.data());
+  K_.zero_ghosts(interior_load_.data());
   w_.assign(n, 0);
   t_.assign(n, 0);
   z_.assign(n, 0);
@@ -129,17 +136,12 @@ SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* exte
 }
 
 SolveStats SteklovPoincare::residual(const real* u, real* r, real rtol, real* body, const real* guess) const {
-  // the load on this rank's rows (all of it on one rank); its interior part
-  // is the solve's right-hand side besides -K_ic u
-  Field<real>& load = load_;
-  load.resize(full_size());
-  global_to_local(slab(), P_.load.data(), load.data());
-  Field<real> lc(3 * p_);
-  gather(load.data(), lc.data());
-  zero_constrained(box(), mg_->op(0).faces(), load.data());
-  K_.zero_ghosts(load.data());
-  const SolveStats st = extend(u, load.data(), r, rtol, body, guess);
-  axpy(3 * p_, -1, lc.data(), r);
+  // the interior load is the solve's right-hand side besides -K_ic u (a
+  // copy: extend adds that plane into it)
+  load_.resize(full_size());
+  copy(full_size(), interior_load_.data(), load_.data());
+  const SolveStats st = extend(u, load_.data(), r, rtol, body, guess);
+  axpy(3 * p_, -1, contact_load_.data(), r);
   return st;
 }
 

@@ -128,7 +128,8 @@ class SteklovPoincare {
   index c_begin_ = 0, c_end_ = 0;  // this rank's contact nodes
   std::vector<int> counts_, displs_;           // every rank's contact nodes (whole())
   mutable CGWorkspace ws_;  // scratch
-  mutable Field<real> w_, t_, z_, load_;  // load_: residual()'s l on this rank's rows
+  Field<real> interior_load_, contact_load_;  // l_i (K_ii's rows: 3D) and l_c (3p), this rank's
+  mutable Field<real> w_, t_, z_, load_;     // load_: residual()'s right-hand side
 };
 
 }  // namespace tresca

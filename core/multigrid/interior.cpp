@@ -16,9 +16,7 @@ InteriorSolution solve_interior_elasticity(const Problem& P, const Multigrid& mg
   auto norm = [&](const real* v) { return std::sqrt(reduce ? reduce->sum(dot(n, v, v)) : dot(n, v, v)); };
   InteriorSolution s;
   s.u.resize(n);
-  std::vector<real> local(n);
-  global_to_local(K.slab(), P.load.data(), local.data());
-  Field<real> b = placed_field<real>(local);
+  Field<real> b = local_rows(K.slab(), P.load.data());
   zero_constrained(K.grid(), K.faces(), b.data());
   K.zero_ghosts(b.data());
   CGOptions o;
