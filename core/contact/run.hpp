@@ -86,6 +86,8 @@ struct RunTimes {
   double setup = 0, condense = 0, solve = 0, recover = 0, total = 0;
 };
 
+// Everything in it is host values, wherever the launches ran (--device gpu:
+// the solve's Fields are copied out at its end).
 struct RunResult {
   std::unique_ptr<Problem> problem;
   RunTimes times;

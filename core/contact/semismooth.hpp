@@ -136,7 +136,7 @@ struct NewtonOptions {
     o.kink_contact = false;
     return o;
   }
-  // optional initial iterate (default x0 = 0): u0 (3p) and lambda0 (p)
+  // optional initial iterate (default x0 = 0): u0 (3p) and lambda0 (p), host values
   const std::vector<real>* u0 = nullptr;
   const std::vector<real>* lambda0 = nullptr;
   // optional: a guess of the body's displacement at u0 (S.full_size(),
@@ -160,6 +160,8 @@ struct NewtonOptions {
   FrictionLaw friction;
 };
 
+// Host values (the iteration's own vectors live where the launches run and
+// are copied out at its end), except body, a Field where the launches ran.
 struct NewtonResult {
   NewtonReason reason = NewtonReason::iteration_limit;
   int iterations = 0;                  // Newton steps taken
