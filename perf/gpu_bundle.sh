@@ -59,7 +59,11 @@ contact() {  # level, then tresca options
   local level=$1; shift
   "$here/tresca" --level "$level" "$@" --device gpu --profile --contact-csv "$out/gpu_$level.csv" --json "$out/gpu_$level.json"
   "$here/tresca" --level "$level" "$@" --quiet --contact-csv "$out/cpu_$level.csv" --json "$out/cpu_$level.json"
-  grep -o '"newton_iterations":[0-9]*' "$out/gpu_$level.json" "$out/cpu_$level.json" || true
+  local f  # this mesh's Newton steps and inner iterations (the first of each key: not a nested level's)
+  for f in gpu cpu; do
+    echo "$f: $(grep -m1 -o '"newton_iterations": *[0-9]*' "$out/${f}_$level.json")," \
+         "$(grep -m1 -o '"inner_iterations": *[0-9]*' "$out/${f}_$level.json")"
+  done
   echo "level $level $*: GPU against CPU: $(compare "$out/gpu_$level.csv" "$out/cpu_$level.csv")"
 }
 stage=${1:-all}
