@@ -63,7 +63,7 @@ void solve_coarser_mesh(const ProblemSpec& spec, const RunOptions& opt, RunResul
   co.tight_rtol = std::max(opt.tight_rtol, 1e-3 * opt.nested_rtol);
   co.newton.residual_accuracy = std::max(opt.newton.residual_accuracy, 1e-3 * opt.nested_rtol);
   co.contact = coarse_conditions(R.problem->grid, R.contact, grid_of(cs));
-  const RunResult C = run_tresca(cs, co);
+  RunResult C = run_tresca(cs, co);
   R.nested = C.nested;
   R.nested.push_back({cs, int(C.newton_steps()), C.converged(), C.fine_matvecs_total - C.nested_fine_matvecs,
                       C.times.total - C.times.nested});
@@ -81,11 +81,10 @@ void solve_coarser_mesh(const ProblemSpec& spec, const RunOptions& opt, RunResul
   start.load_guess.resize(n);
   start.body.resize(n);
   // (the coarser run's results are host values: back where the launches run)
-  Field<real> coarse_load = C.interior_load, coarse_body = C.u_full;
-  coarse_load.move_to(launch_space());
-  coarse_body.move_to(launch_space());
-  prolongate_slabs(C.slab, coarse_load.data(), fine, start.load_guess.data(), comm);
-  prolongate_slabs(C.slab, coarse_body.data(), fine, start.body.data(), comm);
+  C.interior_load.move_to(launch_space());
+  C.u_full.move_to(launch_space());
+  prolongate_slabs(C.slab, C.interior_load.data(), fine, start.load_guess.data(), comm);
+  prolongate_slabs(C.slab, C.u_full.data(), fine, start.body.data(), comm);
   newton.body0 = &start.body;
 }
 

@@ -404,8 +404,8 @@ class NewtonSolve {
   real fscale = 1;  // |b̃|
   real r_err = 0;   // bounds the error of the current r
   Field<real> gap;              // the law's gaps
-  Field<real> scale, units;     // the step's metric (empty: the paper's s = 1) and the consistent units'
-  const real* scale_ptr = nullptr;
+  Field<real> units;            // the stiffness of the consistent units
+  const real* scale_ptr = nullptr;  // the step's metric: units, or nullptr (the paper's s = 1)
   // the iterate x, and a trial point of the line search (its own bound:
   // Coulomb's bound of a rejected trial must not outlive it)
   Point x, trial;
@@ -453,8 +453,7 @@ NewtonSolve::NewtonSolve(const SteklovPoincare& S_, const ContactConditions& giv
   units = placed_field<real>(R.units);
   if (opt.scaling == StepScaling::diagonal) {
     R.scale = R.units;
-    scale = units;
-    scale_ptr = scale.data();
+    scale_ptr = units.data();  // (the same array: approximation_step then computes the step once)
   }
   if (opt.u0) x.u = placed_field<real>(*opt.u0);
   if (opt.lambda0) x.lambda = placed_field<real>(*opt.lambda0);
