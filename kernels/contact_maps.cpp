@@ -45,6 +45,9 @@ ResidualNorms approximation_step(index p, const ContactLaw& law, const real* sca
                                  const real* lambda, const real* r, real* v, real* w, real* d, std::uint8_t* status) {
   TRESCA_ASSERT(p >= 0 && (p == 0 || (law.phi != nullptr && law.gap != nullptr)));
   // per-node work in parallel, then the deterministic blocked sum of v.v.
+  // (A block per node: on a GPU one lane of a warp does a node. In simd
+  // lanes, for_each_entry, GCC 12's nvptx backend stops with an internal
+  // compiler error in make_decl_rtl; p is the contact face, small.)
   // (The test oracle is the dense reference Newton in tests/test_newton.cpp.)
   for_each_block(p, double(p) * kApproximationStepCost, [=](index i) {
     // x3 enters through F_4 = u_z + g

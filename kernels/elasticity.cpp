@@ -270,7 +270,7 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
   const index band = (rows_y + nbands - 1) / nbands;
   const double nodes = double(nx) * double(rows_y) * double(rows.z_end - rows.z_begin);
   const StencilView<T> v = view(k);
-  for_each_block(nbands, nodes * in_precision<T>(kApplyCost), [v, x, y, b, rows, nx, ny, N, band](index bnd) {
+  for_each_host_block(nbands, nodes * in_precision<T>(kApplyCost), [v, x, y, b, rows, nx, ny, N, band](index bnd) {
     for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
       for (index iy = rows.y_begin + bnd * band; iy < std::min(rows.y_end, rows.y_begin + (bnd + 1) * band); ++iy)
         sweep_row(v, nx, ny, N, iz, iy, x, y, b,
@@ -374,6 +374,7 @@ void elasticity_diagonal(const ElasticityStencil& k, real* d) {
   const index nx = g.nx(), N = g.nodes();
   for_each_block(g.nz(), g.ny(), double(N) * kDiagonalCost, [=](index iz, index iy) {
     const std::uint8_t cy = v.cls[1][iy], cz = v.cls[2][iz];
+#pragma omp simd
     for (index ix = 0; ix < nx; ++ix) {
       const std::uint8_t cx = v.cls[0][ix];
       const index n = ix + nx * (iy + g.ny() * iz);

@@ -38,7 +38,21 @@ bool launch_on_device() { return on_device; }
 void set_launch_on_device(bool on) {
   if (on && !offload_built())
     throw std::invalid_argument("this build has no device backend (configure with -DTRESCA_OFFLOAD=ON)");
+  if (on) device_warps();  // a bad TRESCA_DEVICE_WARPS stops here, before any launch
   on_device = on;
+}
+
+int device_warps() {
+  static const int warps = [] {
+    const char* e = std::getenv("TRESCA_DEVICE_WARPS");
+    if (e == nullptr || *e == '\0') return 8;
+    char* end = nullptr;
+    const long w = std::strtol(e, &end, 10);
+    if (*end != '\0' || w < 1 || w > 32)
+      throw std::invalid_argument(std::string("TRESCA_DEVICE_WARPS=") + e + " must be a warp count in 1..32");
+    return int(w);
+  }();
+  return warps;
 }
 
 namespace {
@@ -225,9 +239,11 @@ void* device_scratch(std::size_t bytes) {
 }
 
 std::string device_description() {
+  if (!offload_built()) return "none (built without offload)";
   const int n = omp_get_num_devices();
-  if (n == 0) return offload_built() ? "none: target regions run on the host" : "none (built without offload)";
-  return "device " + std::to_string(omp_get_default_device()) + " of " + std::to_string(n) + " (OpenMP offload)";
+  const std::string teams = ", " + std::to_string(device_warps()) + " warps a team";
+  if (n == 0) return "none: target regions run on the host" + teams;
+  return "device " + std::to_string(omp_get_default_device()) + " of " + std::to_string(n) + " (OpenMP offload)" + teams;
 }
 
 }  // namespace tresca

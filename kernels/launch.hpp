@@ -40,8 +40,19 @@ namespace tresca {
 bool launch_on_device();
 void set_launch_on_device(bool on);  // throws std::invalid_argument if the build has no offload
 bool offload_built();                // whether this build has TRESCA_OFFLOAD
-// "device 0 of 1 (OpenMP offload)", or "none: target regions run on the host"
+// "device 0 of 1 (OpenMP offload), 8 warps a team", "none: target regions
+// run on the host, 8 warps a team" or "none (built without offload)"
 std::string device_description();
+
+// Warps a team of every device launch: the thread_limit of its target region
+// (GCC's nvptx backend maps an OpenMP thread to a warp, its simd lanes to the
+// warp's 32 lanes). libgomp then starts as many teams as the GPU's registers
+// hold at once: floor(registers an SM / (registers a thread x 32 x warps)) a
+// multiprocessor, so fewer warps a team can fit more warps an SM where the
+// kernels' register count is not a divisor (perf/offload_registers.py,
+// RESULTS.md §0n). From TRESCA_DEVICE_WARPS (1..32), read once; default 8,
+// libgomp's own. Throws std::invalid_argument for any other value.
+int device_warps();
 
 // Launches (and new Fields) are the host's inside this scope, and where
 // they were before after it: for builders that fill Fields entry by entry
@@ -82,9 +93,9 @@ bool device_guarded();  // whether that guard is on
 // scratch for a device launch: `bytes` of device memory, kept and reused
 // from launch to launch (one launch at a time)
 void* device_scratch(std::size_t bytes);
-// the blocks' scratch on the device: kScratchTeams x kScratchThreads
-// workers, each with its own slice
-constexpr int kScratchTeams = 1024, kScratchThreads = 8;
+// the blocks' scratch on the device: at most kScratchTeams teams of
+// device_warps() workers, each with its own slice
+constexpr int kScratchTeams = 1024;
 
 // How many workers a launch has (threads on the host): a kernel that cuts
 // its range into cache-sized blocks makes at least one block per worker.
@@ -100,13 +111,25 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
     // firstprivate clause: an internal compiler error)
     DeviceRegion region;
     Body b = body;
-#pragma omp target teams distribute parallel for simd
+    const int warps = device_warps();
+#pragma omp target teams distribute parallel for simd thread_limit(warps)
     for (index i = 0; i < n; ++i) b(i);
     return;
   }
 #endif
 #pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * per_entry))
   for (index i = 0; i < n; ++i) body(i);
+}
+
+// body(b) for every block b in [0, n) on the host's threads only, for a
+// kernel whose device form is another function (the banded apply: its
+// device form is elasticity_apply_rows). Its body stays out of the device
+// image: there the most register-hungry body sets the registers, and so the
+// occupancy, of every kernel (perf/offload_registers.py, RESULTS.md §0n).
+template <class Body>
+inline void for_each_host_block(index n, Cost work, const Body& body) {
+#pragma omp parallel for schedule(static) if (worth_threads(work))
+  for (index b = 0; b < n; ++b) body(b);
 }
 
 // body(b) for every block b in [0, n): independent blocks of work (rows,
@@ -118,13 +141,13 @@ inline void for_each_block(index n, Cost work, const Body& body) {
   if (launch_on_device()) {
     DeviceRegion region;
     Body b = body;
-#pragma omp target teams distribute parallel for
+    const int warps = device_warps();
+#pragma omp target teams distribute parallel for thread_limit(warps)
     for (index i = 0; i < n; ++i) b(i);
     return;
   }
 #endif
-#pragma omp parallel for schedule(static) if (worth_threads(work))
-  for (index b = 0; b < n; ++b) body(b);
+  for_each_host_block(n, work, body);
 }
 
 // body(j, i) for every block of an n1 x n0 range (j slow, i fast).
@@ -134,7 +157,8 @@ inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
   if (launch_on_device()) {  // one block per (team) thread; the body's own `omp simd` loops in its lanes
     DeviceRegion region;
     Body b = body;
-#pragma omp target teams distribute parallel for collapse(2)
+    const int warps = device_warps();
+#pragma omp target teams distribute parallel for collapse(2) thread_limit(warps)
     for (index j = 0; j < n1; ++j)
       for (index i = 0; i < n0; ++i) b(j, i);
     return;
@@ -151,13 +175,14 @@ template <class T, class Body>
 inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost work, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {  // each (team, thread) its slice of one scratch buffer
-    T* pool = static_cast<T*>(device_scratch(std::size_t(kScratchTeams) * kScratchThreads * scratch * sizeof(T)));
+    const int warps = device_warps();
+    T* pool = static_cast<T*>(device_scratch(std::size_t(kScratchTeams) * warps * scratch * sizeof(T)));
     DeviceRegion region;
     Body b = body;
-#pragma omp target teams distribute parallel for collapse(2) num_teams(kScratchTeams) thread_limit(kScratchThreads) is_device_ptr(pool)
+#pragma omp target teams distribute parallel for collapse(2) num_teams(kScratchTeams) thread_limit(warps) is_device_ptr(pool)
     for (index j = 0; j < n1; ++j)
       for (index i = 0; i < n0; ++i)
-        b(j, i, pool + (index(omp_get_team_num()) * kScratchThreads + omp_get_thread_num()) * scratch);
+        b(j, i, pool + (index(omp_get_team_num()) * warps + omp_get_thread_num()) * scratch);
     return;
   }
 #endif
@@ -194,7 +219,8 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
   if (launch_on_device()) {
     DeviceRegion region;
     Entry e = entry;
-#pragma omp target teams distribute map(from : part[0 : nb])
+    const int warps = device_warps();
+#pragma omp target teams distribute map(from : part[0 : nb]) thread_limit(warps)
     for (index b = 0; b < nb; ++b) {
       const index i1 = b + 1 < nb ? (b + 1) * width : n;
       real s = 0;

@@ -112,6 +112,7 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
 #pragma omp simd
       for (index j = 0; j < cnx; ++j) s[j] = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
       T* v = fine + a * Nf + fnx * (iy + fny * iz);
+#pragma omp simd  // (on a GPU: the warp's lanes along x, not one lane)
       for (index ix = 0; ix < fnx; ++ix) {
         const index j = X.j0[ix];
         const T wx = T(X.w[ix]);
@@ -158,6 +159,7 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) 
   // one coarse row (jy, jz); acc: a fine row of the worker's own
   const auto coarse_row = [=](index jz, index jy, T* acc) {
     for (int a = 0; a < comps; ++a) {
+#pragma omp simd
       for (index i = 0; i < fnx; ++i) acc[i] = 0;
       for (index kz = Z.tstart[jz]; kz < Z.tstart[jz + 1]; ++kz)
         for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky) {
@@ -167,6 +169,7 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) 
           for (index i = 0; i < fnx; ++i) acc[i] += w * rr[i];
         }
       T* out = coarse + a * Nc + cnx * (jy + cny * jz);
+#pragma omp simd  // (on a GPU: the warp's lanes along x, not one lane)
       for (index jx = 0; jx < cnx; ++jx) {
         T sx = 0;
         for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += T(X.tw[kx]) * acc[X.tf[kx]];

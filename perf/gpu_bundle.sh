@@ -38,6 +38,10 @@ cat > "$out/run.sh" <<'RUN'
 #                   level 10: the contact values' largest difference relative
 #                   to their largest value (issue 22: <= 1e-10)
 #   run.sh large    tresca --device gpu at levels 13, 14 and 15
+#   run.sh warps    the team size (TRESCA_DEVICE_WARPS 1, 2, 4, 8): the
+#                   level-13 apply, V-cycle and vector benchmarks and a
+#                   level-12 contact solve with each (perf/offload_registers.py
+#                   predicts the occupancy of each; RESULTS.md §0n)
 #   run.sh all      tests, bench, elastic, contact (about 10 minutes)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -84,6 +88,14 @@ if [[ $stage == contact || $stage == all ]]; then
   contact 8
   contact 12
   contact 10 --coulomb 0.8
+fi
+if [[ $stage == warps ]]; then
+  for w in 1 2 4 8; do
+    echo "== TRESCA_DEVICE_WARPS=$w"
+    TRESCA_DEVICE_WARPS=$w "$here/bench_kernels" --benchmark_filter='Device(Apply|ApplyFloat|VCycle)/13|Device(Dot|CgUpdate)/134217728' \
+      --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+    TRESCA_DEVICE_WARPS=$w "$here/tresca" --level 12 --device gpu --quiet --json "$out/warps_$w.json"
+  done
 fi
 if [[ $stage == large ]]; then
   for level in 13 14 15; do
