@@ -121,6 +121,17 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
   for (index i = 0; i < n; ++i) body(i);
 }
 
+// Before a loop inside a block's body whose iterations a GPU warp's lanes
+// should share (in a device body a loop without `omp simd` runs on one
+// lane) but which the CPU runs faster as scalar code (indirect reads: as
+// AVX-512 gathers the transfers took 35 % longer, RESULTS.md §0n):
+// `omp simd` in an offload build only.
+#ifdef TRESCA_OFFLOAD
+#define TRESCA_DEVICE_LANES _Pragma("omp simd")
+#else
+#define TRESCA_DEVICE_LANES
+#endif
+
 // body(b) for every block b in [0, n) on the host's threads only, for a
 // kernel whose device form is another function (the banded apply: its
 // device form is elasticity_apply_rows). Its body stays out of the device

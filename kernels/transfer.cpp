@@ -112,7 +112,7 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
 #pragma omp simd
       for (index j = 0; j < cnx; ++j) s[j] = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
       T* v = fine + a * Nf + fnx * (iy + fny * iz);
-#pragma omp simd  // (on a GPU: the warp's lanes along x, not one lane)
+      TRESCA_DEVICE_LANES
       for (index ix = 0; ix < fnx; ++ix) {
         const index j = X.j0[ix];
         const T wx = T(X.w[ix]);
@@ -169,7 +169,7 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) 
           for (index i = 0; i < fnx; ++i) acc[i] += w * rr[i];
         }
       T* out = coarse + a * Nc + cnx * (jy + cny * jz);
-#pragma omp simd  // (on a GPU: the warp's lanes along x, not one lane)
+      TRESCA_DEVICE_LANES
       for (index jx = 0; jx < cnx; ++jx) {
         T sx = 0;
         for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += T(X.tw[kx]) * acc[X.tf[kx]];
