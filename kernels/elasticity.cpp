@@ -374,7 +374,7 @@ void elasticity_diagonal(const ElasticityStencil& k, real* d) {
   const index nx = g.nx(), N = g.nodes();
   for_each_block(g.nz(), g.ny(), double(N) * kDiagonalCost, [=](index iz, index iy) {
     const std::uint8_t cy = v.cls[1][iy], cz = v.cls[2][iz];
-#pragma omp simd
+    TRESCA_DEVICE_LANES  // (reads slot and center through indices)
     for (index ix = 0; ix < nx; ++ix) {
       const std::uint8_t cx = v.cls[0][ix];
       const index n = ix + nx * (iy + g.ny() * iz);
