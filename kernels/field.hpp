@@ -49,6 +49,18 @@ void space_copy(Space to_space, void* to, Space from_space, const void* from, st
 void space_zero(Space s, void* p, std::size_t bytes);
 [[noreturn]] void field_read_on_host(Space s);  // throws std::logic_error
 
+// Blocks freed by Fields are kept for the next Field of the same size
+// (launch.cpp: large host blocks and every device block; the memory held
+// stays under the largest the live Fields ever needed). What that saved so
+// far, in one space:
+struct BlockReuse {
+  long long requests = 0, reused = 0;  // blocks asked for, and of them, blocks handed out again
+  double reused_bytes = 0;             // their bytes: memory not faulted in (or cudaMalloc'ed) again
+  double kept_bytes = 0;               // bytes kept now for reuse
+  double live_bytes = 0, peak_bytes = 0;  // in live Fields now, and the most ever (kept + live stays below it)
+};
+BlockReuse block_reuse(Space s);
+
 template <class T>
 class Field {
   static_assert(std::is_trivially_copyable<T>::value, "a Field holds plain data that can be copied by bytes");

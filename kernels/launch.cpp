@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <map>
 #include <memory>
+#include <mutex>
 
 #include <cstdlib>
 #include <cstring>
@@ -158,12 +159,12 @@ const char* to_string(Space s) { return s == Space::device ? "device" : "host"; 
 
 Space launch_space() { return on_device ? Space::device : Space::host; }
 
-void* space_allocate(Space s, std::size_t bytes) {
+namespace {
+void* raw_allocate(Space s, std::size_t bytes) {
   return s == Space::device ? device_allocate(bytes) : host_allocate(bytes);
 }
 
-void space_free(Space s, void* p, std::size_t bytes) noexcept {
-  if (!p) return;
+void raw_free(Space s, void* p, std::size_t bytes) noexcept {
   if (s == Space::device)
     device_release(p);
   else if (guard().on && guard().host->release(p))
@@ -174,10 +175,127 @@ void space_free(Space s, void* p, std::size_t bytes) noexcept {
     std::free(p);
 }
 
+// The blocks Fields gave back, kept for the next Field of the same size: a
+// solve makes and drops the same vectors again and again (Lanczos and CG
+// temporaries, each multigrid build's work vectors, each Newton step's), and
+// a fresh block costs page faults and the kernel's zeroing of every page, on
+// one thread (on this VM about 1.5 GB/s: a quarter of a level-12 solve,
+// RESULTS.md §0o); on a GPU each fresh block is a cudaMalloc. Large host
+// blocks and all device blocks are kept; small host blocks come from malloc,
+// which keeps them itself.
+//
+// The memory held (live blocks + kept ones) never passes the largest the
+// live blocks ever needed: before a fresh block is made, kept blocks are
+// given back, oldest first, until it fits under that peak.
+class BlockCache {
+ public:
+  explicit BlockCache(Space s) : space_(s) {}
+  void* allocate(std::size_t bytes) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.requests;
+    for (std::size_t k = kept_.size(); k-- > 0;)  // the newest of this size: likeliest in cache
+      if (kept_[k].bytes == bytes) {
+        void* p = kept_[k].p;
+        kept_.erase(kept_.begin() + std::ptrdiff_t(k));
+        kept_bytes_ -= bytes;
+        live_ += bytes;
+        ++stats_.reused;
+        stats_.reused_bytes += double(bytes);
+        return p;
+      }
+    peak_ = std::max(peak_, live_ + bytes);
+    while (!kept_.empty() && live_ + kept_bytes_ + bytes > peak_) give_back_oldest();
+    void* p;
+    try {
+      p = raw_allocate(space_, bytes);
+    } catch (const std::bad_alloc&) {
+      while (!kept_.empty()) give_back_oldest();
+      p = raw_allocate(space_, bytes);
+    }
+    live_ += bytes;
+    return p;
+  }
+  void release(void* p, std::size_t bytes) noexcept {
+    std::lock_guard<std::mutex> lock(mutex_);
+    live_ -= bytes;
+    try {
+      kept_.push_back({bytes, p});
+      kept_bytes_ += bytes;
+    } catch (...) {
+      raw_free(space_, p, bytes);
+    }
+  }
+  BlockReuse stats() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    BlockReuse r = stats_;
+    r.kept_bytes = double(kept_bytes_);
+    r.live_bytes = double(live_);
+    r.peak_bytes = double(peak_);
+    return r;
+  }
+
+ private:
+  struct Block {
+    std::size_t bytes;
+    void* p;
+  };
+  void give_back_oldest() noexcept {
+    raw_free(space_, kept_.front().p, kept_.front().bytes);
+    kept_bytes_ -= kept_.front().bytes;
+    kept_.erase(kept_.begin());
+  }
+  Space space_;
+  std::mutex mutex_;
+  std::vector<Block> kept_;  // oldest first
+  std::size_t live_ = 0, kept_bytes_ = 0, peak_ = 0;
+  BlockReuse stats_;
+};
+
+// never destroyed: Fields with static storage may outlive any other static
+BlockCache& block_cache(Space s) {
+  static BlockCache* host = new BlockCache(Space::host);
+  static BlockCache* device = new BlockCache(Space::device);
+  return s == Space::device ? *device : *host;
+}
+bool kept_when_freed(Space s, std::size_t bytes) { return s == Space::device || bytes >= kHugeFrom; }
+}  // namespace
+
+void* space_allocate(Space s, std::size_t bytes) {
+  return kept_when_freed(s, bytes) ? block_cache(s).allocate(bytes) : raw_allocate(s, bytes);
+}
+
+void space_free(Space s, void* p, std::size_t bytes) noexcept {
+  if (!p) return;
+  if (kept_when_freed(s, bytes))
+    block_cache(s).release(p, bytes);
+  else
+    raw_free(s, p, bytes);
+}
+
+BlockReuse block_reuse(Space s) { return block_cache(s).stats(); }
+
+namespace {
+// piece(begin, size) over [0, bytes), each host worker its contiguous share
+// (the share schedule(static) gives it in the kernels that sweep the entries
+// later): a fresh block's first touch, and its page faults, on every thread
+// instead of one. Small ranges stay on the calling thread (worth_threads).
+template <class Piece>
+void by_host_shares(std::size_t bytes, const Piece& piece) {
+  const index w = launch_width();
+  for_each_host_block(w, Cost{double(bytes), 0}, [&](index t) {
+    const std::size_t b0 = bytes / std::size_t(w) * std::size_t(t) + std::min(bytes % std::size_t(w), std::size_t(t));
+    const std::size_t b1 = b0 + bytes / std::size_t(w) + (std::size_t(t) < bytes % std::size_t(w) ? 1 : 0);
+    piece(b0, b1 - b0);
+  });
+}
+}  // namespace
+
 void space_copy(Space to_space, void* to, Space from_space, const void* from, std::size_t bytes) {
   if (bytes == 0) return;
   if (to_space == Space::host && from_space == Space::host) {
-    std::memcpy(to, from, bytes);
+    by_host_shares(bytes, [&](std::size_t b, std::size_t n) {
+      std::memcpy(static_cast<char*>(to) + b, static_cast<const char*>(from) + b, n);
+    });
     return;
   }
   DeviceRegion region(true);
@@ -202,7 +320,7 @@ void space_zero(Space s, void* p, std::size_t bytes) {
     std::memset(p, 0, bytes);
     return;
   }
-  std::memset(p, 0, bytes);
+  by_host_shares(bytes, [&](std::size_t b, std::size_t n) { std::memset(static_cast<char*>(p) + b, 0, n); });
 }
 
 bool device_guarded() { return guard().on; }

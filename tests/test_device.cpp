@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <cstdint>
 #include <cstdlib>
 
 #include <algorithm>
@@ -85,6 +86,57 @@ TEST(Field, LivesWhereItIsMadeAndMovesOnRequest) {
   e.push_back(7);
   EXPECT_EQ(e.space(), Space::host);
   EXPECT_EQ(e.size(), 1u);
+}
+
+// A large block a Field gives back is handed to the next Field of its size
+// (no page faults again), zeroed like a fresh one; the memory kept for that
+// never lifts what is held above the most the live Fields ever needed.
+TEST(Field, AFreedLargeBlockIsReusedAndZeroed) {
+  const std::size_t n = (std::size_t(3) << 20) / sizeof(real);  // 3 MiB: a kept size
+  const real* first;
+  {
+    Field<real> a(n);
+    std::fill(a.begin(), a.end(), 1.5);
+    first = a.data();
+  }
+  const BlockReuse before = block_reuse(Space::host);
+  Field<real> b(n);
+  const BlockReuse after = block_reuse(Space::host);
+  EXPECT_EQ(b.data(), first) << "the block just freed, handed out again";
+  EXPECT_EQ(after.requests, before.requests + 1);
+  EXPECT_EQ(after.reused, before.reused + 1);
+  EXPECT_DOUBLE_EQ(after.reused_bytes - before.reused_bytes, double(n * sizeof(real)));
+  EXPECT_TRUE(std::all_of(b.begin(), b.end(), [](real v) { return v == 0; })) << "a reused block is zeroed";
+  // sizes that do not match: kept blocks are given back rather than held
+  // above the peak
+  for (std::size_t k = 1; k <= 6; ++k) {
+    Field<real> c(n + k * 100000), d(n / 2 + k);
+    const BlockReuse s = block_reuse(Space::host);
+    EXPECT_LE(s.live_bytes + s.kept_bytes, s.peak_bytes) << "step " << k;
+    EXPECT_GE(s.live_bytes, double((2 * n + n / 2 + k * 100000 + k) * sizeof(real)));
+  }
+}
+
+// copies and zeroing of large host ranges are split among the threads (each
+// its share of the bytes, first touch in parallel): every byte, at any
+// length and thread count
+TEST(Field, LargeCopiesAndZeroingCoverEveryByte) {
+  const int keep = omp_get_max_threads();
+  for (const std::size_t n : {std::size_t(1000003), std::size_t(3) << 20}) {
+    std::vector<std::uint8_t> v(n);
+    for (std::size_t i = 0; i < n; ++i) v[i] = std::uint8_t(1 + i % 251);
+    for (int threads : {1, 2, 3, 7}) {
+      omp_set_num_threads(threads);
+      Field<std::uint8_t> a(v.begin(), v.end());
+      const Field<std::uint8_t> b = a;  // host to host: a copy by shares
+      EXPECT_TRUE(std::equal(b.begin(), b.end(), v.begin())) << n << " bytes, " << threads << " threads";
+      a.clear();
+      a.resize(n);  // kept storage, new entries zero: zeroing by shares
+      EXPECT_TRUE(std::all_of(a.begin(), a.end(), [](std::uint8_t x) { return x == 0; }))
+          << n << " bytes, " << threads << " threads";
+    }
+  }
+  omp_set_num_threads(keep);
 }
 
 // the guard that the device.guarded run relies on: a host read through a

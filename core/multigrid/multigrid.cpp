@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "kernels/boundary_block.hpp"
+#include "kernels/launch.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/multigrid/smoothing.hpp"
 #include "core/util/profile.hpp"
@@ -238,20 +239,25 @@ void Multigrid::estimate_lmax(int l) {
   const index n = lv.A.size();
   Field<real> dinv = lv.A.diagonal();
   reciprocal_or_zero(n, dinv.data(), dinv.data());
-  // the start vector by global dof index: runs of nx entries (one node row),
-  // made on the host and moved where the launches run
-  std::vector<real> start(n);
+  // the start vector by global dof index: runs of nx entries (one node row,
+  // each from its own jump of the generator), made on the host's threads and
+  // moved where the launches run
   const GridDims &box = h.slab.local, &G = h.grid;
-  const index N = box.nodes(), row0 = h.slab.y_begin - h.slab.lo;
-  for (int c = 0; c < 3; ++c)
-    for (index iz = 0; iz < box.nz(); ++iz)
-      for (index j = 0; j < box.ny(); ++j) {
-        const index k0 = c * G.nodes() + G.node(0, row0 + j, iz);
-        std::uint64_t s = Lcg::jump(12345, std::uint64_t(k0) + 1);
-        real* out = start.data() + c * N + box.node(0, j, iz);
-        for (index ix = 0; ix < box.nx(); ++ix, s = Lcg::a * s + Lcg::c) out[ix] = Lcg::value(s);
-      }
-  Field<real> r = placed_field<real>(start);
+  const index N = box.nodes(), row0 = h.slab.y_begin - h.slab.lo, ny = box.ny(), nz = box.nz();
+  Field<real> r;
+  {
+    HostLaunches host;
+    r = Field<real>(std::size_t(n));
+    real* start = r.data();
+    for_each_host_block(3 * nz * ny, double(n) * Cost{8, 4}, [=, &G, &box](index row) {
+      const index c = row / (nz * ny), iz = (row / ny) % nz, j = row % ny;
+      const index k0 = c * G.nodes() + G.node(0, row0 + j, iz);
+      std::uint64_t s = Lcg::jump(12345, std::uint64_t(k0) + 1);
+      real* out = start + c * N + box.node(0, j, iz);
+      for (index ix = 0; ix < box.nx(); ++ix, s = Lcg::a * s + Lcg::c) out[ix] = Lcg::value(s);
+    });
+    r.move_to(host.space_before());
+  }
   zero_constrained(box, lv.A.faces(), r.data());
   lv.A.zero_ghosts(r.data());
   lv.lmax = lanczos_lmax(

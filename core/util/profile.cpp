@@ -121,6 +121,16 @@ std::string profile_table(double total) {
   }
   out += "(time: the row's whole time; self: less the rows timed inside it, e.g. the smoother less its\n"
          " applies; share: self / total, so the shares add up to 100 %; other: outside every timer)\n";
+  // the Fields' block cache (field.hpp), since the program started
+  for (Space s : {Space::host, Space::device}) {
+    const BlockReuse b = block_reuse(s);
+    if (b.requests == 0) continue;
+    std::snprintf(line, sizeof line,
+                  "%s blocks%s: %lld made, %lld of them reused (%.2f GB not %s again); at most %.2f GB in Fields\n",
+                  to_string(s), s == Space::host ? " of 1 MiB and more" : "", b.requests, b.reused,
+                  b.reused_bytes * 1e-9, s == Space::host ? "faulted in" : "allocated", b.peak_bytes * 1e-9);
+    out += line;
+  }
   return out;
 }
 
