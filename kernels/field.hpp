@@ -23,7 +23,9 @@
 // Host storage of 1 MiB or more is aligned to 2 MiB and marked
 // MADV_HUGEPAGE, so where the kernel's transparent-huge-page mode is
 // "madvise" (Debian's default) its first touch costs one page fault per
-// 2 MiB instead of per 4 KiB (perf/RESULTS.md §0d, §0k).
+// 2 MiB instead of per 4 KiB (perf/RESULTS.md §0d, §0k); zeroing and
+// copying it are split among the threads, so that first touch runs on
+// every core (§0o).
 #pragma once
 #include <algorithm>
 #include <cstddef>

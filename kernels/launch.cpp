@@ -36,6 +36,12 @@ bool offload_built() {
 
 bool launch_on_device() { return on_device; }
 
+std::atomic<long long> detail::launches[3];
+
+LaunchCounts launch_counts() {
+  return {detail::launches[0].load(), detail::launches[1].load(), detail::launches[2].load()};
+}
+
 void set_launch_on_device(bool on) {
   if (on && !offload_built())
     throw std::invalid_argument("this build has no device backend (configure with -DTRESCA_OFFLOAD=ON)");
@@ -308,6 +314,7 @@ void space_zero(Space s, void* p, std::size_t bytes) {
   if (bytes == 0) return;
 #ifdef TRESCA_OFFLOAD
   if (s == Space::device) {
+    detail::counted_device_launch();
     DeviceRegion region;
     unsigned char* q = static_cast<unsigned char*>(p);
 #pragma omp target teams distribute parallel for is_device_ptr(q) device(device())

@@ -25,6 +25,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,25 @@ void* device_scratch(std::size_t bytes);
 // device_warps() workers, each with its own slice
 constexpr int kScratchTeams = 1024;
 
+// The launches so far, by where they ran: the fork/join census of
+// `--profile` and bench_kernels. A threaded launch is one OpenMP parallel
+// region (a fork, a join and its barrier); a one-thread launch ran on the
+// calling thread, its work below worth_threads.
+struct LaunchCounts {
+  long long threaded = 0, one_thread = 0, device = 0;
+};
+LaunchCounts launch_counts();
+namespace detail {
+extern std::atomic<long long> launches[3];  // threaded, one_thread, device
+// worth_threads(work), the launch counted as what it will be
+inline bool counted_host_launch(Cost work) {
+  const bool threads = worth_threads(work);
+  launches[threads ? 0 : 1].fetch_add(1, std::memory_order_relaxed);
+  return threads;
+}
+inline void counted_device_launch() { launches[2].fetch_add(1, std::memory_order_relaxed); }
+}  // namespace detail
+
 // How many workers a launch has (threads on the host): a kernel that cuts
 // its range into cache-sized blocks makes at least one block per worker.
 inline index launch_width() { return omp_get_max_threads(); }
@@ -106,6 +126,7 @@ template <class Body>
 inline void for_each_entry(index n, Cost per_entry, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
+    detail::counted_device_launch();
     // a copy of the body, mapped implicitly: its captures (device pointers,
     // scalars) travel by value (GCC 12 fails on a lambda in a map or
     // firstprivate clause: an internal compiler error)
@@ -117,7 +138,7 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
     return;
   }
 #endif
-#pragma omp parallel for simd schedule(static) if (parallel : worth_threads(double(n) * per_entry))
+#pragma omp parallel for simd schedule(static) if (parallel : detail::counted_host_launch(double(n) * per_entry))
   for (index i = 0; i < n; ++i) body(i);
 }
 
@@ -139,7 +160,7 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
 // occupancy, of every kernel (perf/offload_registers.py, RESULTS.md §0n).
 template <class Body>
 inline void for_each_host_block(index n, Cost work, const Body& body) {
-#pragma omp parallel for schedule(static) if (worth_threads(work))
+#pragma omp parallel for schedule(static) if (detail::counted_host_launch(work))
   for (index b = 0; b < n; ++b) body(b);
 }
 
@@ -150,6 +171,7 @@ template <class Body>
 inline void for_each_block(index n, Cost work, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
+    detail::counted_device_launch();
     DeviceRegion region;
     Body b = body;
     const int warps = device_warps();
@@ -166,6 +188,7 @@ template <class Body>
 inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {  // one block per (team) thread; the body's own `omp simd` loops in its lanes
+    detail::counted_device_launch();
     DeviceRegion region;
     Body b = body;
     const int warps = device_warps();
@@ -175,7 +198,7 @@ inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
     return;
   }
 #endif
-#pragma omp parallel for collapse(2) schedule(static) if (worth_threads(work))
+#pragma omp parallel for collapse(2) schedule(static) if (detail::counted_host_launch(work))
   for (index j = 0; j < n1; ++j)
     for (index i = 0; i < n0; ++i) body(j, i);
 }
@@ -186,6 +209,7 @@ template <class T, class Body>
 inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost work, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {  // each (team, thread) its slice of one scratch buffer
+    detail::counted_device_launch();
     const int warps = device_warps();
     T* pool = static_cast<T*>(device_scratch(std::size_t(kScratchTeams) * warps * scratch * sizeof(T)));
     DeviceRegion region;
@@ -197,7 +221,7 @@ inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost 
     return;
   }
 #endif
-#pragma omp parallel if (worth_threads(work))
+#pragma omp parallel if (detail::counted_host_launch(work))
   {
     std::vector<T> buffer(scratch);
     T* s = buffer.data();
@@ -228,6 +252,7 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
   (void)entry;  // (the host's form is block)
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
+    detail::counted_device_launch();
     DeviceRegion region;
     Entry e = entry;
     const int warps = device_warps();
@@ -241,7 +266,7 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
     }
   } else
 #endif
-#pragma omp parallel for schedule(static) if (worth_threads(double(n) * per_entry))
+#pragma omp parallel for schedule(static) if (detail::counted_host_launch(double(n) * per_entry))
   for (index b = 0; b < nb; ++b) part[b] = block(b * width, std::min(n, (b + 1) * width));
   real s = 0;
   for (index b = 0; b < nb; ++b) s += part[b];

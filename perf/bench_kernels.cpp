@@ -96,16 +96,32 @@ void BM_VCycle(benchmark::State& st) {
   {
     Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
     Field<real> r = placed_field<real>(h), z(P.dofs());
+    const LaunchCounts n0 = launch_counts();
     for (auto _ : st) {
       mg.apply(r.data(), z.data());
       benchmark::DoNotOptimize(z.data());
     }
+    // the fork/join census of one V-cycle (launch.hpp)
+    const LaunchCounts n1 = launch_counts();
+    const double cycles = double(st.iterations());
+    st.counters["regions"] = double(n1.threaded - n0.threaded) / cycles;
+    st.counters["one_thread"] = double(n1.one_thread - n0.one_thread) / cycles;
+    st.counters["device_launches"] = double(n1.device - n0.device) / cycles;
   }
   done(kRun);
   set_rates(st, double(P.dofs()), 0, 0);
 }
 BENCHMARK_TEMPLATE(BM_VCycle, Run::host)->Name("VCycle")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_VCycle, Run::device)->Name("DeviceVCycle")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// One empty parallel region through the launch layer: the price of a fork,
+// a join and its barrier at this thread count (times the `regions` of a
+// V-cycle or the census of `tresca --profile`: what the threads cost).
+void BM_ParallelRegion(benchmark::State& st) {
+  for (auto _ : st) for_each_host_block(launch_width(), Cost{kParallelWork, 0}, [](index) {});
+  st.counters["omp_threads"] = omp_get_max_threads();
+}
+BENCHMARK(BM_ParallelRegion)->Name("ParallelRegion")->UseRealTime();
 
 template <Run kRun>
 void BM_Transfer(benchmark::State& st) {
@@ -162,7 +178,10 @@ static const char* kHelp =
     "The kernels one by one on the fields of mesh levels 6-12 (Apply, ApplyFloat, ApplyRef: the\n"
     "serial _ref twin, VCycle, RestrictProlong, Dot), each with the counters DoF/s, bytes/s and\n"
     "FLOP/s from the kernels' cost models, omp_threads and dofs; the build (ISA, vector width,\n"
-    "compiler) and the offload device are in the context header. Device*: the same kernels\n"
+    "compiler) and the offload device are in the context header. VCycle also counts its\n"
+    "launches (regions: parallel regions a cycle, one_thread: launches too small for threads);\n"
+    "ParallelRegion: the time of one empty parallel region (fork, join, barrier) at this\n"
+    "thread count. Device*: the same kernels\n"
     "(DeviceApply, DeviceApplyFloat, DeviceVCycle, DeviceRestrictProlong, DeviceDot, DeviceAxpy,\n"
     "DeviceCgUpdate) with every field in device memory, through the offload backend (a\n"
     "-DTRESCA_OFFLOAD=ON build; otherwise they are skipped with that message).\n"

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "kernels/launch.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"
 
@@ -40,6 +41,27 @@ TEST(VectorOps, ReductionsAreBitwiseIndependentOfThreadCount) {
   const real d2 = dot(n, x.data(), y.data());
   omp_set_num_threads(threads);
   EXPECT_EQ(d1, d2);
+}
+
+// the fork/join census (launch.hpp): each launch counted once, as a parallel
+// region where its work is worth threads, on the calling thread otherwise
+TEST(VectorOps, LaunchesAreCountedByWhereTheyRan) {
+  const index big = 1 << 20, small = 8;
+  ASSERT_TRUE(worth_threads(double(big) * kAxpyCost));
+  ASSERT_FALSE(worth_threads(double(small) * kAxpyCost));
+  const auto x = test::random_vector(big, 11);
+  auto y = test::random_vector(big, 12);
+  const LaunchCounts a = launch_counts();
+  axpy(big, 0.5, x.data(), y.data());
+  const LaunchCounts b = launch_counts();
+  axpy(small, 0.5, x.data(), y.data());
+  axpy(small, 0.5, x.data(), y.data());
+  const LaunchCounts c = launch_counts();
+  EXPECT_EQ(b.threaded - a.threaded, 1);
+  EXPECT_EQ(b.one_thread - a.one_thread, 0);
+  EXPECT_EQ(c.threaded - b.threaded, 0);
+  EXPECT_EQ(c.one_thread - b.one_thread, 2);
+  EXPECT_EQ(c.device, a.device);
 }
 
 TEST(VectorOps, ChebyshevUpdatesFollowTheirFormulas) {

@@ -121,7 +121,14 @@ std::string profile_table(double total) {
   }
   out += "(time: the row's whole time; self: less the rows timed inside it, e.g. the smoother less its\n"
          " applies; share: self / total, so the shares add up to 100 %; other: outside every timer)\n";
-  // the Fields' block cache (field.hpp), since the program started
+  // the fork/join census (launch.hpp), and the Fields' block cache
+  // (field.hpp), since the program started
+  const LaunchCounts n = launch_counts();
+  std::snprintf(line, sizeof line,
+                "launches: %lld parallel regions on %d threads, %lld on one thread (below worth_threads), "
+                "%lld on the device\n",
+                n.threaded, omp_get_max_threads(), n.one_thread, n.device);
+  out += line;
   for (Space s : {Space::host, Space::device}) {
     const BlockReuse b = block_reuse(s);
     if (b.requests == 0) continue;
