@@ -14,6 +14,9 @@
 #   roofline  roofline --level 12 with all cores: every kernel against the triad
 #   large     levels 13 and 14 with all cores, then level 15 (memory
 #             estimate, time, peak memory)
+#   profile   where the threads' time goes: level 12's kernel profile with 1
+#             thread and with all cores (with the fork/join census and the
+#             memory made), and the price of one parallel region
 # LEVEL, LEVELS, SWEEP and THREADS replace 12, 10-12, 1,2,4,8,16 and the
 # core count (e.g. LEVEL=4 LEVELS=3-4 SWEEP=1,2 to try it on 2 cores).
 # Each stage prints what it ran (command, date, machine) before its figures:
@@ -59,7 +62,13 @@ case $stage in
       KEEP="$solve|estimated|converged" run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores \
         "$b/bin/tresca" --level "$level"
     done ;;
+  profile)
+    for t in 1 "$T"; do
+      TAIL=22 run env OMP_NUM_THREADS="$t" OMP_PROC_BIND=close OMP_PLACES=cores "$b/bin/tresca" --level "$L" --quiet --profile
+    done
+    KEEP='^(ParallelRegion|VCycle)' run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores \
+      "$b/bin/bench_kernels" --benchmark_filter='ParallelRegion|^VCycle/10' ;;
   *)
-    echo "unknown stage '$stage': threads, scaling, ranks, roofline or large" >&2
+    echo "unknown stage '$stage': threads, scaling, ranks, roofline, large or profile" >&2
     exit 2 ;;
 esac

@@ -125,7 +125,7 @@ std::string profile_table(double total) {
   // (field.hpp), since the program started
   const LaunchCounts n = launch_counts();
   std::snprintf(line, sizeof line,
-                "launches: %lld parallel regions on %d threads, %lld on one thread (below worth_threads), "
+                "launches: %lld parallel regions on %d thread(s), %lld on one thread (below worth_threads), "
                 "%lld on the device\n",
                 n.threaded, omp_get_max_threads(), n.one_thread, n.device);
   out += line;
