@@ -18,7 +18,7 @@
 #include "core/util/profile.hpp"
 #include "core/contact/run.hpp"
 #include "core/parallel/comm.hpp"
-#include "kernels/simd.hpp"
+#include "kernels/isa.hpp"
 
 using namespace tresca;
 

@@ -1,18 +1,16 @@
 #include "elasticity.hpp"
 
-
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
 
 #include "element.hpp"
+#include "isa.hpp"
 #include "launch.hpp"
-#include "simd.hpp"
+#include "stencil_row.hpp"
 
 namespace tresca {
 namespace {
-
-enum : std::uint8_t { kHasL = 1, kHasR = 2, kDropL = 4, kDropR = 8, kSelf = 16 };
 
 std::uint8_t axis_class(index i, index n, bool c_lo, bool c_hi) {
   auto constrained = [&](index j) { return (c_lo && j == 0) || (c_hi && j == n - 1); };
@@ -28,80 +26,6 @@ std::uint8_t axis_class(index i, index n, bool c_lo, bool c_hi) {
 // Is the neighbour at offset d in {-1, 0, 1} along one axis a constrained
 // node (its coupling is dropped) for a node of class c?
 bool dropped(std::uint8_t c, int d) { return (d < 0 && (c & kDropL)) || (d > 0 && (c & kDropR)); }
-
-// Accumulates the groups [g, ge) whose nonzero outputs are the mask M.
-// V is the target's native vector of Simd<T>::lanes values of T (simd.hpp);
-// each input vector is loaded once and feeds the |M| outputs.
-template <class T, int NV, int M>
-inline void accumulate(const StencilGroupT<T>* g, const StencilGroupT<T>* ge, const T* x, Vec<T>* a0, Vec<T>* a1,
-                       Vec<T>* a2) {
-  using V = Vec<T>;
-  constexpr int kLanes = Simd<T>::lanes;
-  for (; g != ge; ++g) {
-    const T* xp = x + g->off;
-    const T c0 = g->c[0], c1 = g->c[1], c2 = g->c[2];
-    V v[NV];
-    for (int l = 0; l < NV; ++l) v[l] = *reinterpret_cast<const V*>(xp + kLanes * l);
-    for (int l = 0; l < NV; ++l) {
-      if (M & 1) a0[l] += c0 * v[l];
-      if (M & 2) a1[l] += c1 * v[l];
-      if (M & 4) a2[l] += c2 * v[l];
-    }
-  }
-}
-
-// y_a[i..i+W) for the 3 output components of one stencil; f = first + 7*s.
-template <class T, int W>
-inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, const T* x, T* y, const T* b, index N,
-                          index i) {
-  using V = Vec<T>;
-  constexpr int kLanes = Simd<T>::lanes;
-  if constexpr (W % kLanes != 0) {
-    // scalar path for runs shorter than one vector
-    for (int l = 0; l < W; ++l) {
-      T acc[3] = {0, 0, 0};
-      for (const StencilGroupT<T>* q = g + f[0]; q != g + f[7]; ++q)
-        for (int a = 0; a < 3; ++a) acc[a] += q->c[a] * x[i + l + q->off];
-      for (int a = 0; a < 3; ++a) y[a * N + i + l] = b ? b[a * N + i + l] - acc[a] : acc[a];
-    }
-  } else {
-    constexpr int NV = W / kLanes;
-    V a0[NV], a1[NV], a2[NV];
-    for (int l = 0; l < NV; ++l) a0[l] = a1[l] = a2[l] = V{};
-    x += i;
-    accumulate<T, NV, 1>(g + f[0], g + f[1], x, a0, a1, a2);
-    accumulate<T, NV, 2>(g + f[1], g + f[2], x, a0, a1, a2);
-    accumulate<T, NV, 3>(g + f[2], g + f[3], x, a0, a1, a2);
-    accumulate<T, NV, 4>(g + f[3], g + f[4], x, a0, a1, a2);
-    accumulate<T, NV, 5>(g + f[4], g + f[5], x, a0, a1, a2);
-    accumulate<T, NV, 6>(g + f[5], g + f[6], x, a0, a1, a2);
-    accumulate<T, NV, 7>(g + f[6], g + f[7], x, a0, a1, a2);
-    V* out[3] = {a0, a1, a2};
-    for (int a = 0; a < 3; ++a)
-      for (int l = 0; l < NV; ++l) {
-        V* yp = reinterpret_cast<V*>(y + a * N + i + kLanes * l);
-        *yp = b ? *reinterpret_cast<const V*>(b + a * N + i + kLanes * l) - out[a][l] : out[a][l];
-      }
-  }
-}
-
-template <class T>
-inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* x, T* y, const T* b, index N,
-                          index i0, index i1) {
-  constexpr int kLanes = Simd<T>::lanes;
-  // three vectors per block: 9 accumulators + 3 inputs fit the 16 registers of
-  // SSE/AVX2 (and AVX-512's 32); the width is measured (perf/RESULTS.md §0i)
-  constexpr int kW = 3 * kLanes;
-  index i = i0;
-  for (; i + kW <= i1; i += kW) stencil_block<T, kW>(g, f, x, y, b, N, i);
-  for (; i + kLanes <= i1; i += kLanes) stencil_block<T, kLanes>(g, f, x, y, b, N, i);
-  if (i < i1 && i1 - i0 >= kLanes) {
-    // finish with one overlapping vector: recomputes a few outputs of the same run
-    stencil_block<T, kLanes>(g, f, x, y, b, N, i1 - kLanes);
-    return;
-  }
-  for (; i < i1; ++i) stencil_block<T, 1>(g, f, x, y, b, N, i);
-}
 
 }  // namespace
 
@@ -223,41 +147,12 @@ StencilView<T> view(const ElasticityStencilT<T>& k) {
 template StencilView<double> view(const ElasticityStencilT<double>&);
 template StencilView<float> view(const ElasticityStencilT<float>&);
 
-namespace {
-// One node row (iz, iy) of y = K x (or b - K x) over its x-runs: a run of
-// nodes on a constrained face (or the whole row on one) copies x (b - x);
-// every other run hands its stencil (f = first + 7 s) and the row's vectors,
-// offset to the row's first node, to run(f, xr, yr, br, i0, i1). The banded
-// apply and its row form differ only in `run` and in how rows are launched.
-template <class T, class Run>
-inline void sweep_row(const StencilView<T>& k, index nx, index ny, index N, index iz, index iy, const T* x, T* y,
-                      const T* b, const Run& run) {
-  const std::uint8_t cy = k.cls[1][iy], cz = k.cls[2][iz];
-  const index row = nx * (iy + ny * iz);
-  const bool row_fixed = (cy & kSelf) || (cz & kSelf);
-  const T* xr = x + row;
-  T* yr = y + row;
-  const T* br = b ? b + row : nullptr;
-  for (index r = 0; r < k.nruns; ++r) {
-    const index i0 = k.run_begin[r], i1 = k.run_begin[r + 1];
-    const std::uint8_t cx = k.cls[0][i0];
-    if (row_fixed || (cx & kSelf)) {
-      for (int a = 0; a < 3; ++a)
-#pragma omp simd
-        for (index i = i0; i < i1; ++i) yr[a * N + i] = br ? br[a * N + i] - xr[a * N + i] : xr[a * N + i];
-      continue;
-    }
-    run(k.first + 7 * k.slot[(cx * 32 + cy) * 32 + cz], xr, yr, br, i0, i1);
-  }
-}
-}  // namespace
-
 template <class T>
 void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const RowBlock& rows, const T* b) {
   const GridDims& g = k.g;
-  const index nx = g.nx(), ny = g.ny(), N = g.nodes();
+  const index nx = g.nx();
   TRESCA_ASSERT(0 <= rows.z_begin && rows.z_begin <= rows.z_end && rows.z_end <= g.nz());
-  TRESCA_ASSERT(0 <= rows.y_begin && rows.y_begin <= rows.y_end && rows.y_end <= ny);
+  TRESCA_ASSERT(0 <= rows.y_begin && rows.y_begin <= rows.y_end && rows.y_end <= g.ny());
   TRESCA_ASSERT(x != y && (b == nullptr || b != y));  // y is written while x and b are read
   TRESCA_ASSERT(!k.groups.empty());
   if (launch_on_device()) return elasticity_apply_rows(view(k), x, y, rows, b);  // the device's form
@@ -270,13 +165,11 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
   const index band = (rows_y + nbands - 1) / nbands;
   const double nodes = double(nx) * double(rows_y) * double(rows.z_end - rows.z_begin);
   const StencilView<T> v = view(k);
-  for_each_host_block(nbands, nodes * in_precision<T>(kApplyCost), [v, x, y, b, rows, nx, ny, N, band](index bnd) {
-    for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
-      for (index iy = rows.y_begin + bnd * band; iy < std::min(rows.y_end, rows.y_begin + (bnd + 1) * band); ++iy)
-        sweep_row(v, nx, ny, N, iz, iy, x, y, b,
-                  [&](const std::int32_t* f, const T* xr, T* yr, const T* br, index i0, index i1) {
-                    stencil_range<T>(v.groups, f, xr, yr, br, N, i0, i1);
-                  });
+  // each band's arithmetic in the instruction set chosen at start (isa.hpp)
+  const auto apply_rows = isa_apply_rows<T>(isa());
+  for_each_host_block(nbands, nodes * in_precision<T>(kApplyCost), [=](index bnd) {
+    const index y0 = rows.y_begin + bnd * band, y1 = std::min(rows.y_end, y0 + band);
+    if (y0 < y1) apply_rows(v, x, y, RowBlock{rows.z_begin, rows.z_end, y0, y1}, b);
   });
 }
 template void elasticity_apply<double>(const ElasticityStencilT<double>&, const double*, double*, const RowBlock&,

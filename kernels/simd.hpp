@@ -10,6 +10,12 @@
 // Vec<T> is a GCC/Clang vector extension of kSimdBytes bytes: unaligned
 // (alignment of T) and may_alias, so it can be loaded from and stored to plain
 // arrays of T at any offset through reinterpret_cast.
+//
+// One program holds translation units compiled for different instruction
+// sets (kernels/isa.hpp: the compute-bound kernels once per set, chosen at
+// run time). Each width's definitions live in an inline namespace of their
+// own (simd64, simd32, ...), so the AVX-512 unit's Vec<double> and the
+// baseline's are different types, not one name defined twice.
 #pragma once
 #include <string>
 
@@ -25,7 +31,11 @@
 #endif
 #endif
 
+#define TRESCA_SIMD_NS_CAT(b) simd##b
+#define TRESCA_SIMD_NS(b) TRESCA_SIMD_NS_CAT(b)
+
 namespace tresca {
+inline namespace TRESCA_SIMD_NS(TRESCA_SIMD_BYTES) {
 
 constexpr int kSimdBytes = TRESCA_SIMD_BYTES;
 static_assert(kSimdBytes == 8 || kSimdBytes == 16 || kSimdBytes == 32 || kSimdBytes == 64,
@@ -39,12 +49,27 @@ struct Simd {
 template <class T>
 using Vec = typename Simd<T>::type;
 
-// Instruction set the kernels were compiled for, from the target macros
-// (e.g. "AVX-512F", "AVX2+FMA", "SSE4.2", "NEON", "generic").
-const char* simd_isa();
-// One line tying a measurement to its build: ISA, vector width, the -march
-// flags CMake passed, compiler; e.g.
-// "ISA AVX-512F, 512-bit vectors (8 doubles), -march=native, GCC 12.2.0"
-std::string build_info();
+// Instruction set this translation unit was compiled for, from the target
+// macros (e.g. "AVX-512F", "AVX2+FMA", "SSE4.2", "NEON", "generic").
+constexpr const char* simd_isa() {
+#if defined(__AVX512F__)
+  return "AVX-512F";
+#elif defined(__AVX2__) && defined(__FMA__)
+  return "AVX2+FMA";
+#elif defined(__AVX2__)
+  return "AVX2";
+#elif defined(__AVX__)
+  return "AVX";
+#elif defined(__SSE4_2__)
+  return "SSE4.2";
+#elif defined(__SSE2__)
+  return "SSE2";
+#elif defined(__ARM_NEON)
+  return "NEON";
+#else
+  return "generic";
+#endif
+}
 
+}  // namespace TRESCA_SIMD_NS(TRESCA_SIMD_BYTES)
 }  // namespace tresca

@@ -14,7 +14,7 @@
 #include "core/multigrid/multigrid.hpp"
 #include "core/fem/problem.hpp"
 #include "kernels/launch.hpp"
-#include "kernels/simd.hpp"
+#include "kernels/isa.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 

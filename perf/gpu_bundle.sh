@@ -9,8 +9,10 @@
 # which runs the device tests, the Device* benchmarks (BENCH=regex), roofline
 # --device gpu at level 13, the elastic and the contact solves with --device
 # gpu against the host's, and the large levels (run.sh's own header).
-# The bundle's build has no MPI (fewer libraries to carry) and targets
-# x86-64-v3 (AVX2) for its host code: its host figures are not the CPU's best.
+# The bundle's build has no MPI (fewer libraries to carry) and x86-64-v3
+# (AVX2) as the baseline of its host code; its apply takes the x86-64-v4
+# (AVX-512) variant where the host CPU has it (kernels/isa.hpp), so its host
+# figures are the CPU's apply at full width.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-.gpu-bundle}

@@ -8,7 +8,7 @@
 #include "core/multigrid/interior.hpp"
 #include "core/io/output.hpp"
 #include "core/util/profile.hpp"
-#include "kernels/simd.hpp"
+#include "kernels/isa.hpp"
 
 using namespace tresca;
 

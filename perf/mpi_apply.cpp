@@ -28,7 +28,7 @@
 #include "core/solvers/cg.hpp"
 #include "core/multigrid/multigrid.hpp"
 #include "core/util/profile.hpp"
-#include "kernels/simd.hpp"
+#include "kernels/isa.hpp"
 #include "kernels/vector_ops.hpp"
 
 using namespace tresca;

@@ -6,7 +6,7 @@
 // traffic it really causes (32 bytes: writing a also reads it into cache,
 // write-allocate). The latter is the bound used below, because in-place
 // updates (axpy, cg_update) move exactly their modelled bytes. Then the flop peak of the build's vectors
-// (independent FMA chains in registers, Vec<double> of kernels/simd.hpp).
+// (independent FMA chains in registers, the vectors of the kernels' instruction set, kernels/isa.hpp).
 // Then every kernel on the fields of mesh level L, timed best of several
 // repetitions, with its modelled bytes and flops (the Cost constants in the
 // kernel headers). A kernel's roofline bound is max(bytes / triad, flops /
@@ -35,7 +35,7 @@
 #include "kernels/boundary_block.hpp"
 #include "kernels/contact_maps.hpp"
 #include "kernels/elasticity.hpp"
-#include "kernels/simd.hpp"
+#include "kernels/isa.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/vector_ops.hpp"
 
@@ -48,28 +48,18 @@ double best_of(int reps, const std::function<void()>& f) {
   return best_time(reps, f);
 }
 
-// peak flop/s of the build's vectors of T: K independent FMA chains per thread
+// peak flop/s of T on every thread: 12 independent FMA chains of the
+// vectors of the kernels' instruction set (kernels/isa.hpp)
 template <class T>
 double fma_peak(long iterations) {
-  using V = Vec<T>;
   constexpr int K = 12;
-  real sink = 0;
-  const double t = best_of(3, [&] {
-    real total = 0;
-#pragma omp parallel reduction(+ : total)
-    {
-      V acc[K];
-      for (int k = 0; k < K; ++k) acc[k] = V{} + T(k + 1) * T(1e-3);
-      const V a = V{} + T(0.999999), b = V{} + T(1e-7);
-      for (long it = 0; it < iterations; ++it)
-        for (int k = 0; k < K; ++k) acc[k] = acc[k] * a + b;
-      for (int k = 0; k < K; ++k)
-        for (int l = 0; l < Simd<T>::lanes; ++l) total += acc[k][l];
-    }
-    sink += total;
-  });
+  const IsaKernels& v = isa();
+  double (*chains)(long) = sizeof(T) == sizeof(float) ? v.fma_chains_f : v.fma_chains_d;
+  double sink = 0;
+  const double t = best_of(3, [&] { sink += chains(iterations); });
   if (!(sink > 0)) std::fprintf(stderr, "roofline: FMA check failed\n");
-  return 2.0 * K * Simd<T>::lanes * double(iterations) * omp_get_max_threads() / t;
+  const int lanes = v.vector_bytes / int(sizeof(T));
+  return 2.0 * K * lanes * double(iterations) * omp_get_max_threads() / t;
 }
 
 const char* kHelp =

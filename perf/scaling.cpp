@@ -25,7 +25,7 @@
 #include "core/multigrid/interior.hpp"
 #include "core/util/profile.hpp"
 #include "core/contact/run.hpp"
-#include "kernels/simd.hpp"
+#include "kernels/isa.hpp"
 
 using namespace tresca;
 

@@ -41,35 +41,37 @@ TEST(ElasticityApply, MatchesAssembledMatrixOnOddSizes) {
 }
 
 TEST(ElasticityApply, OptimisedEqualsReferenceIncludingPlaneRanges) {
-  for (auto& s : kSizes)
-    for (unsigned faces : kFaceSets) {
-      const GridDims g = test::prism(s[0], s[1], s[2]);
-      const ElasticityStencil k = build_elasticity_stencil(g, faces, 1.0, 0.3);
-      auto x = random_vector(k.size(), 5);
-      for (index zb = 0; zb < g.nz(); ++zb) {
-        const index ze = std::min(g.nz(), zb + 2);
-        std::vector<real> y(k.size(), 7.0), yr(k.size(), 7.0);
-        elasticity_apply(k, x.data(), y.data(), zb, ze);
-        elasticity_apply_ref(k, x.data(), yr.data(), zb, ze);
-        EXPECT_LT(max_abs_diff(y, yr), 1e-13 * max_abs(yr));
-        // fused residual r = b - K x
-        auto b = random_vector(k.size(), 6);
-        std::vector<real> r(k.size(), 7.0), rr(k.size(), 7.0);
-        elasticity_apply(k, x.data(), r.data(), zb, ze, b.data());
-        elasticity_apply_ref(k, x.data(), rr.data(), zb, ze, b.data());
-        EXPECT_LT(max_abs_diff(r, rr), 1e-13 * max_abs(yr));
-        for (index iz = zb; iz < ze; ++iz)
-          for (index n = iz * g.nx() * g.ny(); n < (iz + 1) * g.nx() * g.ny(); ++n)
-            for (int a = 0; a < 3; ++a) {
-              const index j = a * g.nodes() + n;
-              EXPECT_NEAR(r[j], b[j] - yr[j], 1e-13 * max_abs(yr));
-            }
+  test::for_each_isa([&](const IsaKernels&) {
+    for (auto& s : kSizes)
+      for (unsigned faces : kFaceSets) {
+        const GridDims g = test::prism(s[0], s[1], s[2]);
+        const ElasticityStencil k = build_elasticity_stencil(g, faces, 1.0, 0.3);
+        auto x = random_vector(k.size(), 5);
+        for (index zb = 0; zb < g.nz(); ++zb) {
+          const index ze = std::min(g.nz(), zb + 2);
+          std::vector<real> y(k.size(), 7.0), yr(k.size(), 7.0);
+          elasticity_apply(k, x.data(), y.data(), zb, ze);
+          elasticity_apply_ref(k, x.data(), yr.data(), zb, ze);
+          EXPECT_LT(max_abs_diff(y, yr), 1e-13 * max_abs(yr));
+          // fused residual r = b - K x
+          auto b = random_vector(k.size(), 6);
+          std::vector<real> r(k.size(), 7.0), rr(k.size(), 7.0);
+          elasticity_apply(k, x.data(), r.data(), zb, ze, b.data());
+          elasticity_apply_ref(k, x.data(), rr.data(), zb, ze, b.data());
+          EXPECT_LT(max_abs_diff(r, rr), 1e-13 * max_abs(yr));
+          for (index iz = zb; iz < ze; ++iz)
+            for (index n = iz * g.nx() * g.ny(); n < (iz + 1) * g.nx() * g.ny(); ++n)
+              for (int a = 0; a < 3; ++a) {
+                const index j = a * g.nodes() + n;
+                EXPECT_NEAR(r[j], b[j] - yr[j], 1e-13 * max_abs(yr));
+              }
+        }
+        std::vector<real> d(k.size()), dr(k.size());
+        elasticity_diagonal(k, d.data());
+        elasticity_diagonal_ref(k, dr.data());
+        EXPECT_LT(max_abs_diff(d, dr), 1e-14 * max_abs(dr));
       }
-      std::vector<real> d(k.size()), dr(k.size());
-      elasticity_diagonal(k, d.data());
-      elasticity_diagonal_ref(k, dr.data());
-      EXPECT_LT(max_abs_diff(d, dr), 1e-14 * max_abs(dr));
-    }
+  });
 }
 
 // the row-parallel form (the device's, here on host threads): the banded
@@ -77,53 +79,57 @@ TEST(ElasticityApply, OptimisedEqualsReferenceIncludingPlaneRanges) {
 // the compiler fuses multiply-adds differently in the two loops), on every
 // size, face set and block of rows, plain and fused
 TEST(ElasticityApply, RowFormEqualsTheBandedApply) {
-  for (auto& s : kSizes)
-    for (unsigned faces : kFaceSets) {
-      const GridDims g = test::prism(s[0], s[1], s[2]);
-      const ElasticityStencil k = build_elasticity_stencil(g, faces, 1.0, 0.3);
-      const auto x = random_vector(k.size(), 5), b = random_vector(k.size(), 6);
-      const RowBlock blocks[] = {{0, g.nz(), 0, g.ny()}, {g.nz() / 2, g.nz(), g.ny() / 2, g.ny()}};
-      for (const RowBlock& rows : blocks)
-        for (const real* bb : {(const real*)nullptr, b.data()}) {
-          std::vector<real> y(k.size(), 7.0), yr(k.size(), 7.0);
-          elasticity_apply(k, x.data(), y.data(), rows, bb);
-          elasticity_apply_rows(view(k), x.data(), yr.data(), rows, bb);
-          EXPECT_LE(max_abs_diff(y, yr), 1e-14 * max_abs(y)) << s[0] << "x" << s[1] << "x" << s[2] << " faces " << faces;
+  test::for_each_isa([&](const IsaKernels&) {
+    for (auto& s : kSizes)
+      for (unsigned faces : kFaceSets) {
+        const GridDims g = test::prism(s[0], s[1], s[2]);
+        const ElasticityStencil k = build_elasticity_stencil(g, faces, 1.0, 0.3);
+        const auto x = random_vector(k.size(), 5), b = random_vector(k.size(), 6);
+        const RowBlock blocks[] = {{0, g.nz(), 0, g.ny()}, {g.nz() / 2, g.nz(), g.ny() / 2, g.ny()}};
+        for (const RowBlock& rows : blocks)
+          for (const real* bb : {(const real*)nullptr, b.data()}) {
+            std::vector<real> y(k.size(), 7.0), yr(k.size(), 7.0);
+            elasticity_apply(k, x.data(), y.data(), rows, bb);
+            elasticity_apply_rows(view(k), x.data(), yr.data(), rows, bb);
+            EXPECT_LE(max_abs_diff(y, yr), 1e-14 * max_abs(y)) << s[0] << "x" << s[1] << "x" << s[2] << " faces " << faces;
+          }
+        const auto kf = stencil_in_precision<float>(k);
+        std::vector<float> xf(x.begin(), x.end()), yf(k.size()), yfr(k.size());
+        elasticity_apply(kf, xf.data(), yf.data(), RowBlock{0, g.nz(), 0, g.ny()});
+        elasticity_apply_rows(view(kf), xf.data(), yfr.data(), RowBlock{0, g.nz(), 0, g.ny()});
+        float m = 0, d = 0;
+        for (size_t i = 0; i < yf.size(); ++i) {
+          m = std::max(m, std::abs(yf[i]));
+          d = std::max(d, std::abs(yf[i] - yfr[i]));
         }
-      const auto kf = stencil_in_precision<float>(k);
-      std::vector<float> xf(x.begin(), x.end()), yf(k.size()), yfr(k.size());
-      elasticity_apply(kf, xf.data(), yf.data(), RowBlock{0, g.nz(), 0, g.ny()});
-      elasticity_apply_rows(view(kf), xf.data(), yfr.data(), RowBlock{0, g.nz(), 0, g.ny()});
-      float m = 0, d = 0;
-      for (size_t i = 0; i < yf.size(); ++i) {
-        m = std::max(m, std::abs(yf[i]));
-        d = std::max(d, std::abs(yf[i] - yfr[i]));
+        EXPECT_LE(d, 1e-5f * m) << "float";
       }
-      EXPECT_LE(d, 1e-5f * m) << "float";
-    }
+  });
 }
 
 TEST(ElasticityApply, SinglePrecisionMatchesReferenceToFloatRounding) {
-  for (auto& s : kSizes)
-    for (unsigned faces : kFaceSets) {
-      const GridDims g = test::prism(s[0], s[1], s[2]);
-      const ElasticityStencil k = build_elasticity_stencil(g, faces, 2.1e9, 0.277);
-      const ElasticityStencilT<float> kf = stencil_in_precision<float>(k);
-      const auto x = random_vector(k.size(), 5), b = random_vector(k.size(), 6);
-      std::vector<float> xf(x.begin(), x.end()), bf(b.begin(), b.end()), yf(k.size()), rf(k.size());
-      // the reference on the float-rounded input, so only the kernel's rounding differs
-      const std::vector<real> xr(xf.begin(), xf.end()), br(bf.begin(), bf.end());
-      std::vector<real> yr(k.size()), rr(k.size());
-      elasticity_apply_ref(k, xr.data(), yr.data(), 0, g.nz());
-      elasticity_apply_ref(k, xr.data(), rr.data(), 0, g.nz(), br.data());
-      elasticity_apply<float>(kf, xf.data(), yf.data(), 0, g.nz());
-      elasticity_apply<float>(kf, xf.data(), rf.data(), 0, g.nz(), bf.data());
-      // 27-point sums of terms up to |Ke| |x|: float rounding ~ 1e-7 of the largest term
-      const real scale = max_abs(std::vector<real>(k.Ke.begin(), k.Ke.end())) * 27 * 3;
-      EXPECT_LT(max_abs_diff(std::vector<real>(yf.begin(), yf.end()), yr), 1e-6 * scale)
-          << s[0] << "x" << s[1] << "x" << s[2] << " faces " << faces;
-      EXPECT_LT(max_abs_diff(std::vector<real>(rf.begin(), rf.end()), rr), 1e-6 * scale);
-    }
+  test::for_each_isa([&](const IsaKernels&) {
+    for (auto& s : kSizes)
+      for (unsigned faces : kFaceSets) {
+        const GridDims g = test::prism(s[0], s[1], s[2]);
+        const ElasticityStencil k = build_elasticity_stencil(g, faces, 2.1e9, 0.277);
+        const ElasticityStencilT<float> kf = stencil_in_precision<float>(k);
+        const auto x = random_vector(k.size(), 5), b = random_vector(k.size(), 6);
+        std::vector<float> xf(x.begin(), x.end()), bf(b.begin(), b.end()), yf(k.size()), rf(k.size());
+        // the reference on the float-rounded input, so only the kernel's rounding differs
+        const std::vector<real> xr(xf.begin(), xf.end()), br(bf.begin(), bf.end());
+        std::vector<real> yr(k.size()), rr(k.size());
+        elasticity_apply_ref(k, xr.data(), yr.data(), 0, g.nz());
+        elasticity_apply_ref(k, xr.data(), rr.data(), 0, g.nz(), br.data());
+        elasticity_apply<float>(kf, xf.data(), yf.data(), 0, g.nz());
+        elasticity_apply<float>(kf, xf.data(), rf.data(), 0, g.nz(), bf.data());
+        // 27-point sums of terms up to |Ke| |x|: float rounding ~ 1e-7 of the largest term
+        const real scale = max_abs(std::vector<real>(k.Ke.begin(), k.Ke.end())) * 27 * 3;
+        EXPECT_LT(max_abs_diff(std::vector<real>(yf.begin(), yf.end()), yr), 1e-6 * scale)
+            << s[0] << "x" << s[1] << "x" << s[2] << " faces " << faces;
+        EXPECT_LT(max_abs_diff(std::vector<real>(rf.begin(), rf.end()), rr), 1e-6 * scale);
+      }
+  });
 }
 
 TEST(ElasticityApply, IsSymmetric) {

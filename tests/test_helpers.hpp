@@ -5,7 +5,10 @@
 #include <cstdint>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "kernels/grid.hpp"
+#include "kernels/isa.hpp"
 #include "kernels/types.hpp"
 
 namespace tresca::test {
@@ -47,6 +50,20 @@ real max_abs_diff(const VecA& a, const VecB& b) {
   real m = 0;
   for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
   return m;
+}
+
+// f() once with each instruction-set variant this program holds and this
+// processor runs (kernels/isa.hpp), the failures traced to the variant; the
+// variant in use before it after it
+template <class F>
+void for_each_isa(F&& f) {
+  const IsaKernels& before = isa();
+  for (const IsaKernels* v : isa_variants()) {
+    SCOPED_TRACE(std::string("instruction set ") + v->name + " (" + v->id + " variant)");
+    set_isa(*v);
+    f(*v);
+  }
+  set_isa(before);
 }
 
 }  // namespace tresca::test

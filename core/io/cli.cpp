@@ -2,7 +2,7 @@
 
 #include "core/parallel/comm.hpp"
 #include "kernels/launch.hpp"
-#include "kernels/simd.hpp"
+#include "kernels/isa.hpp"
 
 #include <algorithm>
 #include <utility>
@@ -340,6 +340,7 @@ int apply_threads(const Args& a) {
     if (t < 1 || t > 1024) fail("--threads " + std::to_string(t) + " must be in 1..1024");
     omp_set_num_threads(int(t));
   }
+  isa();  // a bad TRESCA_ISA stops here, before any output (kernels/isa.hpp)
   return omp_get_max_threads();
 }
 

@@ -10,7 +10,7 @@
 #include "core/io/output.hpp"
 #include "core/io/problem_file.hpp"
 #include "kernels/launch.hpp"
-#include "kernels/simd.hpp"
+#include "kernels/isa.hpp"
 
 namespace tresca {
 

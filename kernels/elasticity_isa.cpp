@@ -1,0 +1,134 @@
+// The elasticity apply's arithmetic for one band of node rows, and the FMA
+// chains of perf/roofline's flop peak: the compute-bound work, compiled once
+// per instruction set (kernels/isa.hpp). CMake builds this file several
+// times, each with its own -march and its own TRESCA_ISA_NS (isa_baseline,
+// isa_x86_64_v4); the program picks one at start.
+//
+// Nothing here may be shared with other translation units: every function
+// is in this unit's own namespace or has internal linkage (the launches,
+// the std:: templates and the threads stay in elasticity.cpp, compiled for
+// the baseline), so no AVX-512 copy of a shared function can reach the
+// baseline's callers. tests/check_isa.py checks the linked programs for it.
+#include "isa.hpp"
+#include "simd.hpp"
+#include "stencil_row.hpp"
+
+#ifndef TRESCA_ISA_NS
+#error "kernels/elasticity_isa.cpp is compiled by CMake with -DTRESCA_ISA_NS=<namespace> -DTRESCA_ISA_ID=<id>"
+#endif
+
+namespace tresca {
+namespace TRESCA_ISA_NS {
+namespace {
+
+// Accumulates the groups [g, ge) whose nonzero outputs are the mask M.
+// V is the target's native vector of Simd<T>::lanes values of T (simd.hpp);
+// each input vector is loaded once and feeds the |M| outputs.
+template <class T, int NV, int M>
+inline void accumulate(const StencilGroupT<T>* g, const StencilGroupT<T>* ge, const T* x, Vec<T>* a0, Vec<T>* a1,
+                       Vec<T>* a2) {
+  using V = Vec<T>;
+  constexpr int kLanes = Simd<T>::lanes;
+  for (; g != ge; ++g) {
+    const T* xp = x + g->off;
+    const T c0 = g->c[0], c1 = g->c[1], c2 = g->c[2];
+    V v[NV];
+    for (int l = 0; l < NV; ++l) v[l] = *reinterpret_cast<const V*>(xp + kLanes * l);
+    for (int l = 0; l < NV; ++l) {
+      if (M & 1) a0[l] += c0 * v[l];
+      if (M & 2) a1[l] += c1 * v[l];
+      if (M & 4) a2[l] += c2 * v[l];
+    }
+  }
+}
+
+// y_a[i..i+W) for the 3 output components of one stencil; f = first + 7*s.
+template <class T, int W>
+inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, const T* x, T* y, const T* b, index N,
+                          index i) {
+  using V = Vec<T>;
+  constexpr int kLanes = Simd<T>::lanes;
+  if constexpr (W % kLanes != 0) {
+    // scalar path for runs shorter than one vector
+    for (int l = 0; l < W; ++l) {
+      T acc[3] = {0, 0, 0};
+      for (const StencilGroupT<T>* q = g + f[0]; q != g + f[7]; ++q)
+        for (int a = 0; a < 3; ++a) acc[a] += q->c[a] * x[i + l + q->off];
+      for (int a = 0; a < 3; ++a) y[a * N + i + l] = b ? b[a * N + i + l] - acc[a] : acc[a];
+    }
+  } else {
+    constexpr int NV = W / kLanes;
+    V a0[NV], a1[NV], a2[NV];
+    for (int l = 0; l < NV; ++l) a0[l] = a1[l] = a2[l] = V{};
+    x += i;
+    accumulate<T, NV, 1>(g + f[0], g + f[1], x, a0, a1, a2);
+    accumulate<T, NV, 2>(g + f[1], g + f[2], x, a0, a1, a2);
+    accumulate<T, NV, 3>(g + f[2], g + f[3], x, a0, a1, a2);
+    accumulate<T, NV, 4>(g + f[3], g + f[4], x, a0, a1, a2);
+    accumulate<T, NV, 5>(g + f[4], g + f[5], x, a0, a1, a2);
+    accumulate<T, NV, 6>(g + f[5], g + f[6], x, a0, a1, a2);
+    accumulate<T, NV, 7>(g + f[6], g + f[7], x, a0, a1, a2);
+    V* out[3] = {a0, a1, a2};
+    for (int a = 0; a < 3; ++a)
+      for (int l = 0; l < NV; ++l) {
+        V* yp = reinterpret_cast<V*>(y + a * N + i + kLanes * l);
+        *yp = b ? *reinterpret_cast<const V*>(b + a * N + i + kLanes * l) - out[a][l] : out[a][l];
+      }
+  }
+}
+
+template <class T>
+inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* x, T* y, const T* b, index N,
+                          index i0, index i1) {
+  constexpr int kLanes = Simd<T>::lanes;
+  // three vectors per block: 9 accumulators + 3 inputs fit the 16 registers of
+  // SSE/AVX2 (and AVX-512's 32); the width is measured (perf/RESULTS.md §0i)
+  constexpr int kW = 3 * kLanes;
+  index i = i0;
+  for (; i + kW <= i1; i += kW) stencil_block<T, kW>(g, f, x, y, b, N, i);
+  for (; i + kLanes <= i1; i += kLanes) stencil_block<T, kLanes>(g, f, x, y, b, N, i);
+  if (i < i1 && i1 - i0 >= kLanes) {
+    // finish with one overlapping vector: recomputes a few outputs of the same run
+    stencil_block<T, kLanes>(g, f, x, y, b, N, i1 - kLanes);
+    return;
+  }
+  for (; i < i1; ++i) stencil_block<T, 1>(g, f, x, y, b, N, i);
+}
+
+}  // namespace
+
+template <class T>
+void apply_rows(const StencilView<T>& v, const T* x, T* y, const RowBlock& rows, const T* b) {
+  const index nx = v.g.nx(), ny = v.g.ny(), N = v.g.nodes();
+  for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
+    for (index iy = rows.y_begin; iy < rows.y_end; ++iy)
+      sweep_row(v, nx, ny, N, iz, iy, x, y, b,
+                [&](const std::int32_t* f, const T* xr, T* yr, const T* br, index i0, index i1) {
+                  stencil_range<T>(v.groups, f, xr, yr, br, N, i0, i1);
+                });
+}
+
+template <class T>
+double fma_chains(long iterations) {
+  using V = Vec<T>;
+  constexpr int K = 12;
+  double total = 0;
+#pragma omp parallel reduction(+ : total)
+  {
+    V acc[K];
+    for (int k = 0; k < K; ++k) acc[k] = V{} + T(k + 1) * T(1e-3);
+    const V a = V{} + T(0.999999), c = V{} + T(1e-7);
+    for (long it = 0; it < iterations; ++it)
+      for (int k = 0; k < K; ++k) acc[k] = acc[k] * a + c;
+    for (int k = 0; k < K; ++k)
+      for (int l = 0; l < Simd<T>::lanes; ++l) total += double(acc[k][l]);
+  }
+  return total;
+}
+
+extern const IsaKernels kernels;
+const IsaKernels kernels = {TRESCA_ISA_ID,       simd_isa(),         kSimdBytes,        &apply_rows<double>,
+                            &apply_rows<float>,  &fma_chains<double>, &fma_chains<float>};
+
+}  // namespace TRESCA_ISA_NS
+}  // namespace tresca
