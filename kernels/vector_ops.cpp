@@ -118,8 +118,14 @@ void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x) {
 }
 
 template <class T>
-void cheb_first(index n, T t, const T* dinv, const T* b, T* d, T* x) {
-  for_each_entry(n, in_precision<T>(kChebFirstCost), [=](index i) { x[i] = d[i] = t * dinv[i] * b[i]; });
+void cheb_first(index n, T t, const T* dinv, const T* r, T* d, T* x, bool from_zero) {
+  if (from_zero)
+    for_each_entry(n, in_precision<T>(kChebFirstCost), [=](index i) { x[i] = d[i] = t * dinv[i] * r[i]; });
+  else
+    for_each_entry(n, in_precision<T>(kChebFirstOnGuessCost), [=](index i) {
+      d[i] = t * dinv[i] * r[i];
+      x[i] += d[i];
+    });
 }
 
 template void fill<double>(index, double, double*);
@@ -130,8 +136,8 @@ template void convert<float, double>(index, const double*, float*);
 template void convert<double, float>(index, const float*, double*);
 template void cheb_update<double>(index, double, double, const double*, const double*, double*, double*);
 template void cheb_update<float>(index, float, float, const float*, const float*, float*, float*);
-template void cheb_first<double>(index, double, const double*, const double*, double*, double*);
-template void cheb_first<float>(index, float, const float*, const float*, float*, float*);
+template void cheb_first<double>(index, double, const double*, const double*, double*, double*, bool);
+template void cheb_first<float>(index, float, const float*, const float*, float*, float*, bool);
 
 
 }  // namespace tresca

@@ -8,7 +8,7 @@
 //   dot 16n B, 2n F;  axpy 24n B, 2n F;  xpay 24n B, 2n F;
 //   cg_update (x += a p, r -= a q, returns r.r) 48n B, 6n F;
 //   cheb_update (d = s d + t Dinv r, x += d) 40n B, 5n F;
-//   cheb_first (d = t Dinv b, x = d) 32n B, 2n F.
+//   cheb_first (d = t Dinv b, x = d) 32n B, 2n F; (..., x += d) 40n B, 3n F.
 // (Fields of float move half the bytes: in_precision<float>, types.hpp.)
 #pragma once
 #include "types.hpp"
@@ -18,7 +18,7 @@ namespace tresca {
 constexpr index kDotBlock = 4096;
 // per entry (the table above)
 constexpr Cost kDotCost{16, 2}, kAxpyCost{24, 2}, kXpayCost{24, 2}, kCgUpdateCost{48, 6}, kChebUpdateCost{40, 5},
-    kChebFirstCost{32, 2}, kCopyCost{16, 0}, kFillCost{8, 0}, kScaleCost{16, 1}, kHadamardCost{24, 1};
+    kChebFirstCost{32, 2}, kChebFirstOnGuessCost{40, 3}, kCopyCost{16, 0}, kFillCost{8, 0}, kScaleCost{16, 1}, kHadamardCost{24, 1};
 
 real dot(index n, const real* x, const real* y);
 real dot_ref(index n, const real* x, const real* y);
@@ -41,8 +41,10 @@ real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real*
 // d = s d + t dinv .* r; x += d   (T = double, float)
 template <class T>
 void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x);
-// first Chebyshev step from x = 0: d = t dinv .* b; x = d
+// first Chebyshev step, d = t dinv .* r, from x = 0 (x = d; r = b) or from a
+// guess x (x += d; r = b - A x): cheb_update with s = 0, bit for bit, without
+// reading (or first zeroing) the old d
 template <class T>
-void cheb_first(index n, T t, const T* dinv, const T* b, T* d, T* x);
+void cheb_first(index n, T t, const T* dinv, const T* r, T* d, T* x, bool from_zero = true);
 
 }  // namespace tresca

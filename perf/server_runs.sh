@@ -17,6 +17,9 @@
 #   profile   where the threads' time goes: level 12's kernel profile with 1
 #             thread and with all cores (with the fork/join census and the
 #             memory made), and the price of one parallel region
+#   isa       the apply in each instruction-set variant the CPU runs
+#             (TRESCA_ISA: kernels/isa.hpp) on 1 thread and all cores,
+#             double and float, and level 12 with each: which is faster there
 # LEVEL, LEVELS, SWEEP and THREADS replace 12, 10-12, 1,2,4,8,16 and the
 # core count (e.g. LEVEL=4 LEVELS=3-4 SWEEP=1,2 to try it on 2 cores).
 # Each stage prints what it ran (command, date, machine) before its figures:
@@ -68,7 +71,17 @@ case $stage in
     done
     KEEP='^(ParallelRegion|VCycle)' run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores \
       "$b/bin/bench_kernels" --benchmark_filter='ParallelRegion|^VCycle/10' ;;
+  isa)
+    for isa in x86-64-v4 baseline; do
+      for t in 1 "$T"; do
+        KEEP='^Apply' run env TRESCA_ISA=$isa OMP_NUM_THREADS="$t" OMP_PROC_BIND=close OMP_PLACES=cores \
+          "$b/bin/bench_kernels" --benchmark_filter="^Apply(Float)?/$L/" --benchmark_repetitions=3 \
+          --benchmark_report_aggregates_only=true
+      done
+      KEEP="$solve|kernels: ISA" run env TRESCA_ISA=$isa OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores \
+        "$b/bin/tresca" --level "$L"
+    done ;;
   *)
-    echo "unknown stage '$stage': threads, scaling, ranks, roofline, large or profile" >&2
+    echo "unknown stage '$stage': threads, scaling, ranks, roofline, large, profile or isa" >&2
     exit 2 ;;
 esac

@@ -80,6 +80,14 @@ TEST(VectorOps, ChebyshevUpdatesFollowTheirFormulas) {
     ASSERT_NEAR(d[i], 0.5 * dinv[i] * r[i], 1e-15);
     ASSERT_EQ(x[i], d[i]);
   }
+  // from a guess: cheb_update with s = 0 on a zeroed d, bit for bit, whatever d held
+  std::vector<real> d1(n, std::nan("")), x1 = x0, d2(n, 0.0), x2 = x0;
+  cheb_first(n, 0.7, dinv.data(), r.data(), d1.data(), x1.data(), false);
+  cheb_update(n, 0.0, 0.7, dinv.data(), r.data(), d2.data(), x2.data());
+  for (index i = 0; i < n; ++i) {
+    ASSERT_EQ(d1[i], d2[i]);
+    ASSERT_EQ(x1[i], x2[i]);
+  }
 }
 
 }  // namespace tresca

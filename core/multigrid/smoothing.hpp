@@ -26,8 +26,7 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
     cheb_first<T>(n, T(1 / theta), dinv, b, d, x);
   } else {
     residual(x, r);
-    fill<T>(n, 0, d);
-    cheb_update<T>(n, 0, T(1 / theta), dinv, r, d, x);
+    cheb_first<T>(n, T(1 / theta), dinv, r, d, x, false);
   }
   real rho = 1 / sigma;
   for (int k = 1; k < degree; ++k) {
