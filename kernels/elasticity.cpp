@@ -166,10 +166,10 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
   const double nodes = double(nx) * double(rows_y) * double(rows.z_end - rows.z_begin);
   const StencilView<T> v = view(k);
   // each band's arithmetic in the instruction set chosen at start (isa.hpp)
-  const auto apply_rows = isa_apply_rows<T>(isa());
+  const auto apply_band = isa_apply_band<T>(isa());
   for_each_host_block(nbands, nodes * in_precision<T>(kApplyCost), [=](index bnd) {
     const index y0 = rows.y_begin + bnd * band, y1 = std::min(rows.y_end, y0 + band);
-    if (y0 < y1) apply_rows(v, x, y, RowBlock{rows.z_begin, rows.z_end, y0, y1}, b);
+    if (y0 < y1) apply_band(v, x, y, RowBlock{rows.z_begin, rows.z_end, y0, y1}, b);
   });
 }
 template void elasticity_apply<double>(const ElasticityStencilT<double>&, const double*, double*, const RowBlock&,

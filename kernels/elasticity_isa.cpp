@@ -5,9 +5,10 @@
 // isa_x86_64_v4); the program picks one at start.
 //
 // Nothing here may be shared with other translation units: every function
-// is in this unit's own namespace or has internal linkage (the launches,
-// the std:: templates and the threads stay in elasticity.cpp, compiled for
-// the baseline), so no AVX-512 copy of a shared function can reach the
+// is in this unit's own namespace or has internal linkage (the launches of
+// the bands and the std:: templates stay in elasticity.cpp, compiled for
+// the baseline; fma_chains' parallel region is outlined into a function of
+// this namespace), so no AVX-512 copy of a shared function can reach the
 // baseline's callers. tests/check_isa.py checks the linked programs for it.
 #include "isa.hpp"
 #include "simd.hpp"
@@ -98,7 +99,7 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
 }  // namespace
 
 template <class T>
-void apply_rows(const StencilView<T>& v, const T* x, T* y, const RowBlock& rows, const T* b) {
+void apply_band(const StencilView<T>& v, const T* x, T* y, const RowBlock& rows, const T* b) {
   const index nx = v.g.nx(), ny = v.g.ny(), N = v.g.nodes();
   for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
     for (index iy = rows.y_begin; iy < rows.y_end; ++iy)
@@ -127,8 +128,8 @@ double fma_chains(long iterations) {
 }
 
 extern const IsaKernels kernels;
-const IsaKernels kernels = {TRESCA_ISA_ID,       simd_isa(),         kSimdBytes,        &apply_rows<double>,
-                            &apply_rows<float>,  &fma_chains<double>, &fma_chains<float>};
+const IsaKernels kernels = {TRESCA_ISA_ID,      simd_isa(),          kSimdBytes,        &apply_band<double>,
+                            &apply_band<float>, &fma_chains<double>, &fma_chains<float>};
 
 }  // namespace TRESCA_ISA_NS
 }  // namespace tresca

@@ -33,9 +33,9 @@ struct IsaKernels {
   int vector_bytes;  // its vectors (simd.hpp)
   // y = K x (b - K x with b != nullptr) over the node rows of `rows`, serially:
   // the banded apply's work for one band (elasticity.cpp launches the bands)
-  void (*apply_rows_d)(const StencilView<double>&, const double* x, double* y, const RowBlock& rows,
+  void (*apply_band_d)(const StencilView<double>&, const double* x, double* y, const RowBlock& rows,
                        const double* b);
-  void (*apply_rows_f)(const StencilView<float>&, const float* x, float* y, const RowBlock& rows, const float* b);
+  void (*apply_band_f)(const StencilView<float>&, const float* x, float* y, const RowBlock& rows, const float* b);
   // `iterations` rounds of 12 independent FMA chains of this set's vectors on
   // every thread (perf/roofline's flop peak); returns a sum to check
   double (*fma_chains_d)(long iterations);
@@ -53,11 +53,11 @@ const IsaKernels& isa();
 void set_isa(const IsaKernels& v);
 
 template <class T>
-auto isa_apply_rows(const IsaKernels& v) {
+auto isa_apply_band(const IsaKernels& v) {
   if constexpr (sizeof(T) == sizeof(float))
-    return v.apply_rows_f;
+    return v.apply_band_f;
   else
-    return v.apply_rows_d;
+    return v.apply_band_d;
 }
 
 // One line tying a measurement to its build: the kernels' instruction set
