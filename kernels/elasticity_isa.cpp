@@ -112,7 +112,7 @@ void apply_band(const StencilView<T>& v, const T* x, T* y, const RowBlock& rows,
 template <class T>
 double fma_chains(long iterations) {
   using V = Vec<T>;
-  constexpr int K = 12;
+  constexpr int K = kFmaChains;
   double total = 0;
 #pragma omp parallel reduction(+ : total)
   {

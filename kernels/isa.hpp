@@ -26,6 +26,9 @@
 
 namespace tresca {
 
+// the independent FMA chains a thread of IsaKernels::fma_chains_* keeps
+constexpr int kFmaChains = 12;
+
 // One instruction set's compiled variants of the compute-bound kernels.
 struct IsaKernels {
   const char* id;    // "x86-64-v4", "baseline": TRESCA_ISA's values
@@ -36,7 +39,7 @@ struct IsaKernels {
   void (*apply_band_d)(const StencilView<double>&, const double* x, double* y, const RowBlock& rows,
                        const double* b);
   void (*apply_band_f)(const StencilView<float>&, const float* x, float* y, const RowBlock& rows, const float* b);
-  // `iterations` rounds of 12 independent FMA chains of this set's vectors on
+  // `iterations` rounds of kFmaChains independent FMA chains of this set's vectors on
   // every thread (perf/roofline's flop peak); returns a sum to check
   double (*fma_chains_d)(long iterations);
   double (*fma_chains_f)(long iterations);

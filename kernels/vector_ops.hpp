@@ -18,7 +18,8 @@ namespace tresca {
 constexpr index kDotBlock = 4096;
 // per entry (the table above)
 constexpr Cost kDotCost{16, 2}, kAxpyCost{24, 2}, kXpayCost{24, 2}, kCgUpdateCost{48, 6}, kChebUpdateCost{40, 5},
-    kChebFirstCost{32, 2}, kChebFirstOnGuessCost{40, 3}, kCopyCost{16, 0}, kFillCost{8, 0}, kScaleCost{16, 1}, kHadamardCost{24, 1};
+    kChebFirstCost{32, 2}, kChebFirstOnGuessCost{40, 3}, kCopyCost{16, 0}, kFillCost{8, 0}, kScaleCost{16, 1},
+    kHadamardCost{24, 1};
 
 real dot(index n, const real* x, const real* y);
 real dot_ref(index n, const real* x, const real* y);

@@ -48,18 +48,17 @@ double best_of(int reps, const std::function<void()>& f) {
   return best_time(reps, f);
 }
 
-// peak flop/s of T on every thread: 12 independent FMA chains of the
-// vectors of the kernels' instruction set (kernels/isa.hpp)
+// peak flop/s of T on every thread: kFmaChains independent FMA chains of
+// the vectors of the kernels' instruction set (kernels/isa.hpp)
 template <class T>
 double fma_peak(long iterations) {
-  constexpr int K = 12;
   const IsaKernels& v = isa();
   double (*chains)(long) = sizeof(T) == sizeof(float) ? v.fma_chains_f : v.fma_chains_d;
   double sink = 0;
   const double t = best_of(3, [&] { sink += chains(iterations); });
   if (!(sink > 0)) std::fprintf(stderr, "roofline: FMA check failed\n");
   const int lanes = v.vector_bytes / int(sizeof(T));
-  return 2.0 * K * lanes * double(iterations) * omp_get_max_threads() / t;
+  return 2.0 * kFmaChains * lanes * double(iterations) * omp_get_max_threads() / t;
 }
 
 const char* kHelp =
