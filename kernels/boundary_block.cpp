@@ -5,19 +5,19 @@
 namespace tresca {
 
 template <class T>
-void bottom_block_apply(const GridDims& g, T alpha, const T* B, const T* x, T* y) {
+void bottom_block_apply(const GridDims& g, const T* B, const T* x, const ApplyOut<T>& out) {
   const index M = g.nx() * g.ny(), N = g.nodes();
   const T *bxx = B, *bxy = B + M, *byy = B + 2 * M, *bzz = B + 3 * M;
-  for_each_entry(M, in_precision<T>(kBottomBlockCost), [=](index n) {
+  const Cost step = out.dinv ? Cost{72, 18} : Cost{};  // the Chebyshev step's dinv and d
+  for_each_entry(M, in_precision<T>(kBottomBlockCost + step), [=](index n) {
     const T ux = x[n], uy = x[N + n], uz = x[2 * N + n];
-    y[n] += alpha * (bxx[n] * ux + bxy[n] * uy);
-    y[N + n] += alpha * (bxy[n] * ux + byy[n] * uy);
-    y[2 * N + n] += alpha * bzz[n] * uz;
+    add(out, n, bxx[n] * ux + bxy[n] * uy);
+    add(out, N + n, bxy[n] * ux + byy[n] * uy);
+    add(out, 2 * N + n, bzz[n] * uz);
   });
 }
-
-template void bottom_block_apply<double>(const GridDims&, double, const double*, const double*, double*);
-template void bottom_block_apply<float>(const GridDims&, float, const float*, const float*, float*);
+template void bottom_block_apply<double>(const GridDims&, const double*, const double*, const ApplyOut<double>&);
+template void bottom_block_apply<float>(const GridDims&, const float*, const float*, const ApplyOut<float>&);
 
 void bottom_block_diagonal(const GridDims& g, const real* B, real* d) {
   const index M = g.nx() * g.ny(), N = g.nodes();

@@ -148,14 +148,15 @@ template StencilView<double> view(const ElasticityStencilT<double>&);
 template StencilView<float> view(const ElasticityStencilT<float>&);
 
 template <class T>
-void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const RowBlock& rows, const T* b) {
+void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, const ApplyOut<T>& out, const RowBlock& rows) {
   const GridDims& g = k.g;
   const index nx = g.nx();
   TRESCA_ASSERT(0 <= rows.z_begin && rows.z_begin <= rows.z_end && rows.z_end <= g.nz());
   TRESCA_ASSERT(0 <= rows.y_begin && rows.y_begin <= rows.y_end && rows.y_end <= g.ny());
-  TRESCA_ASSERT(x != y && (b == nullptr || b != y));  // y is written while x and b are read
+  // y is written while x and b are read (and x read at entries other than those written)
+  TRESCA_ASSERT(x != out.y && (out.b == nullptr || out.b != out.y));
   TRESCA_ASSERT(!k.groups.empty());
-  if (launch_on_device()) return elasticity_apply_rows(view(k), x, y, rows, b);  // the device's form
+  if (launch_on_device()) return elasticity_apply_rows(view(k), x, out, rows);  // the device's form
   // Cache blocking: each thread sweeps z over a band of about kBand x-rows, so
   // the three input planes of the band (3 x (kBand+2) rows) stay in L2.
   constexpr index kBand = 16;
@@ -167,10 +168,19 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const Ro
   const StencilView<T> v = view(k);
   // each band's arithmetic in the instruction set chosen at start (isa.hpp)
   const auto apply_band = isa_apply_band<T>(isa());
-  for_each_host_block(nbands, nodes * in_precision<T>(kApplyCost), [=](index bnd) {
+  for_each_host_block(nbands, nodes * in_precision<T>(apply_cost(out)), [=](index bnd) {
     const index y0 = rows.y_begin + bnd * band, y1 = std::min(rows.y_end, y0 + band);
-    if (y0 < y1) apply_band(v, x, y, RowBlock{rows.z_begin, rows.z_end, y0, y1}, b);
+    if (y0 < y1) apply_band(v, x, out, RowBlock{rows.z_begin, rows.z_end, y0, y1});
   });
+}
+template void elasticity_apply<double>(const ElasticityStencilT<double>&, const double*, const ApplyOut<double>&,
+                                       const RowBlock&);
+template void elasticity_apply<float>(const ElasticityStencilT<float>&, const float*, const ApplyOut<float>&,
+                                      const RowBlock&);
+
+template <class T>
+void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const RowBlock& rows, const T* b) {
+  elasticity_apply(k, x, b ? residual_out(b, y) : operator_out(y), rows);
 }
 template void elasticity_apply<double>(const ElasticityStencilT<double>&, const double*, double*, const RowBlock&,
                                        const double*);
@@ -178,17 +188,16 @@ template void elasticity_apply<float>(const ElasticityStencilT<float>&, const fl
                                       const float*);
 
 template <class T>
-void elasticity_apply_rows(const StencilView<T>& k, const T* x, T* y, const RowBlock& rows, const T* b) {
+void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T>& out, const RowBlock& rows) {
   const index nx = k.g.nx(), ny = k.g.ny(), N = k.g.nodes();
   TRESCA_ASSERT(0 <= rows.z_begin && rows.z_begin <= rows.z_end && rows.z_end <= k.g.nz());
   TRESCA_ASSERT(0 <= rows.y_begin && rows.y_begin <= rows.y_end && rows.y_end <= ny);
-  TRESCA_ASSERT(x != y && (b == nullptr || b != y));
+  TRESCA_ASSERT(x != out.y && (out.b == nullptr || out.b != out.y));
   const index z0 = rows.z_begin, y0 = rows.y_begin;
   const index nz = rows.z_end - rows.z_begin, nyr = rows.y_end - rows.y_begin;
   const double nodes = double(nx) * double(nz) * double(nyr);
-  for_each_block(nz, nyr, nodes * in_precision<T>(kApplyCost), [=](index jz, index jy) {
-    sweep_row(k, nx, ny, N, z0 + jz, y0 + jy, x, y, b,
-              [&](const std::int32_t* f, const T* xr, T* yr, const T* br, index i0, index i1) {
+  for_each_block(nz, nyr, nodes * in_precision<T>(apply_cost(out)), [=](index jz, index jy) {
+    sweep_row(k, nx, ny, N, z0 + jz, y0 + jy, x, out, [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
                 const StencilGroupT<T>*q0 = k.groups + f[0], *q1 = k.groups + f[7];
 #pragma omp simd
                 for (index i = i0; i < i1; ++i) {
@@ -199,17 +208,17 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, T* y, const RowB
                     acc1 += q->c[1] * v;
                     acc2 += q->c[2] * v;
                   }
-                  yr[i] = br ? br[i] - acc0 : acc0;
-                  yr[N + i] = br ? br[N + i] - acc1 : acc1;
-                  yr[2 * N + i] = br ? br[2 * N + i] - acc2 : acc2;
+                  put(out, x, row + i, acc0);
+                  put(out, x, N + row + i, acc1);
+                  put(out, x, 2 * N + row + i, acc2);
                 }
               });
   });
 }
-template void elasticity_apply_rows<double>(const StencilView<double>&, const double*, double*, const RowBlock&,
-                                            const double*);
-template void elasticity_apply_rows<float>(const StencilView<float>&, const float*, float*, const RowBlock&,
-                                           const float*);
+template void elasticity_apply_rows<double>(const StencilView<double>&, const double*, const ApplyOut<double>&,
+                                            const RowBlock&);
+template void elasticity_apply_rows<float>(const StencilView<float>&, const float*, const ApplyOut<float>&,
+                                           const RowBlock&);
 
 template <class T>
 void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, index z_begin, index z_end, const T* b) {

@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "apply_out.hpp"
 #include "grid.hpp"
 #include "launch.hpp"
 #include "types.hpp"
@@ -89,8 +90,15 @@ ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& k);
 // Cost per output node (double fields; in_precision<float> halves the bytes):
 // y = K x reads x and writes y (3 components each; neighbour rows come from
 // cache), 153 FMAs; the residual b - K x also reads b.
+// The smoother's Chebyshev step (apply_out.hpp) reads dinv and d and writes
+// d and the new iterate (in place of r): 3 x 24 bytes more, 6 flops a dof.
 constexpr Cost kApplyCost{48, 306};
 constexpr Cost kResidualCost{72, 309};
+constexpr Cost kChebStepCost{144, 327};
+template <class T>
+constexpr Cost apply_cost(const ApplyOut<T>& out) {
+  return out.dinv ? kChebStepCost : out.b ? kResidualCost : kApplyCost;
+}
 
 // y = K x for output planes iz in [z_begin, z_end) (the whole grid with
 // z_begin = 0, z_end = g.nz()). With b != nullptr the residual y = b - K x is
@@ -108,6 +116,10 @@ struct RowBlock {
 };
 template <class T>
 void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const RowBlock& rows, const T* b = nullptr);
+// The general form: what each entry's v = (K x)_j becomes is `out`'s
+// (apply_out.hpp: y = v, b - v, or a Chebyshev step of the smoother).
+template <class T>
+void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, const ApplyOut<T>& out, const RowBlock& rows);
 void elasticity_apply_ref(const ElasticityStencil& k, const real* x, real* y, index z_begin, index z_end,
                           const real* b = nullptr);
 
@@ -125,7 +137,7 @@ struct StencilView {
 };
 template <class T>
 StencilView<T> view(const ElasticityStencilT<T>& k);
-// The same y = K x (or b - K x) parallel over node rows, one (z, y) row per
+// The same apply (K x, b - K x or a Chebyshev step) parallel over node rows, one (z, y) row per
 // block with the nodes of its x-runs in `omp simd` lanes: the device's form
 // (a GPU warp per row, its lanes along x: coalesced), run as a target region
 // while launch_on_device() holds (x, y, b and k's arrays then in device
@@ -135,7 +147,7 @@ StencilView<T> view(const ElasticityStencilT<T>& k);
 // same order as elasticity_apply, equal to rounding (multiply-adds fuse
 // differently in the two loops).
 template <class T>
-void elasticity_apply_rows(const StencilView<T>& k, const T* x, T* y, const RowBlock& rows, const T* b = nullptr);
+void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T>& out, const RowBlock& rows);
 
 // d = diag(K) (1 on constrained dofs). Per node: writes 3 values.
 constexpr Cost kDiagonalCost{24, 0};

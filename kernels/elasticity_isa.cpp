@@ -43,10 +43,13 @@ inline void accumulate(const StencilGroupT<T>* g, const StencilGroupT<T>* ge, co
   }
 }
 
-// y_a[i..i+W) for the 3 output components of one stencil; f = first + 7*s.
+// Entries [i, i+W) of the row starting at node `row`, for the 3 output
+// components of one stencil (f = first + 7*s), handed to put() (apply_out.hpp);
+// xr = x + row. The first `done` entries are computed but not put (they
+// were: a Chebyshev step's put may not run twice on an entry).
 template <class T, int W>
-inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, const T* x, T* y, const T* b, index N,
-                          index i) {
+inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, const T* xr, const ApplyOut<T>& o,
+                          const T* x, index row, index N, index i, int done = 0) {
   using V = Vec<T>;
   constexpr int kLanes = Simd<T>::lanes;
   if constexpr (W % kLanes != 0) {
@@ -54,59 +57,60 @@ inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, cons
     for (int l = 0; l < W; ++l) {
       T acc[3] = {0, 0, 0};
       for (const StencilGroupT<T>* q = g + f[0]; q != g + f[7]; ++q)
-        for (int a = 0; a < 3; ++a) acc[a] += q->c[a] * x[i + l + q->off];
-      for (int a = 0; a < 3; ++a) y[a * N + i + l] = b ? b[a * N + i + l] - acc[a] : acc[a];
+        for (int a = 0; a < 3; ++a) acc[a] += q->c[a] * xr[i + l + q->off];
+      for (int a = 0; a < 3; ++a) put(o, x, a * N + row + i + l, acc[a]);
     }
   } else {
     constexpr int NV = W / kLanes;
     V a0[NV], a1[NV], a2[NV];
     for (int l = 0; l < NV; ++l) a0[l] = a1[l] = a2[l] = V{};
-    x += i;
-    accumulate<T, NV, 1>(g + f[0], g + f[1], x, a0, a1, a2);
-    accumulate<T, NV, 2>(g + f[1], g + f[2], x, a0, a1, a2);
-    accumulate<T, NV, 3>(g + f[2], g + f[3], x, a0, a1, a2);
-    accumulate<T, NV, 4>(g + f[3], g + f[4], x, a0, a1, a2);
-    accumulate<T, NV, 5>(g + f[4], g + f[5], x, a0, a1, a2);
-    accumulate<T, NV, 6>(g + f[5], g + f[6], x, a0, a1, a2);
-    accumulate<T, NV, 7>(g + f[6], g + f[7], x, a0, a1, a2);
+    const T* xi = xr + i;
+    accumulate<T, NV, 1>(g + f[0], g + f[1], xi, a0, a1, a2);
+    accumulate<T, NV, 2>(g + f[1], g + f[2], xi, a0, a1, a2);
+    accumulate<T, NV, 3>(g + f[2], g + f[3], xi, a0, a1, a2);
+    accumulate<T, NV, 4>(g + f[3], g + f[4], xi, a0, a1, a2);
+    accumulate<T, NV, 5>(g + f[4], g + f[5], xi, a0, a1, a2);
+    accumulate<T, NV, 6>(g + f[5], g + f[6], xi, a0, a1, a2);
+    accumulate<T, NV, 7>(g + f[6], g + f[7], xi, a0, a1, a2);
     V* out[3] = {a0, a1, a2};
-    for (int a = 0; a < 3; ++a)
-      for (int l = 0; l < NV; ++l) {
-        V* yp = reinterpret_cast<V*>(y + a * N + i + kLanes * l);
-        *yp = b ? *reinterpret_cast<const V*>(b + a * N + i + kLanes * l) - out[a][l] : out[a][l];
+    for (int a = 0; a < 3; ++a) {
+      if (done > 0) {  // (NV = 1: the run's last, overlapping vector)
+        for (int lane = done; lane < kLanes; ++lane) put(o, x, a * N + row + i + lane, out[a][0][lane]);
+        continue;
       }
+      for (int l = 0; l < NV; ++l) put(o, x, a * N + row + i + kLanes * l, out[a][l]);
+    }
   }
 }
 
 template <class T>
-inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* x, T* y, const T* b, index N,
-                          index i0, index i1) {
+inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* xr, const ApplyOut<T>& o,
+                          const T* x, index row, index N, index i0, index i1) {
   constexpr int kLanes = Simd<T>::lanes;
   // three vectors per block: 9 accumulators + 3 inputs fit the 16 registers of
   // SSE/AVX2 (and AVX-512's 32); the width is measured (perf/RESULTS.md §0i)
   constexpr int kW = 3 * kLanes;
   index i = i0;
-  for (; i + kW <= i1; i += kW) stencil_block<T, kW>(g, f, x, y, b, N, i);
-  for (; i + kLanes <= i1; i += kLanes) stencil_block<T, kLanes>(g, f, x, y, b, N, i);
+  for (; i + kW <= i1; i += kW) stencil_block<T, kW>(g, f, xr, o, x, row, N, i);
+  for (; i + kLanes <= i1; i += kLanes) stencil_block<T, kLanes>(g, f, xr, o, x, row, N, i);
   if (i < i1 && i1 - i0 >= kLanes) {
-    // finish with one overlapping vector: recomputes a few outputs of the same run
-    stencil_block<T, kLanes>(g, f, x, y, b, N, i1 - kLanes);
+    // finish with one overlapping vector: computes a few entries again, puts the new ones
+    stencil_block<T, kLanes>(g, f, xr, o, x, row, N, i1 - kLanes, int(i - (i1 - kLanes)));
     return;
   }
-  for (; i < i1; ++i) stencil_block<T, 1>(g, f, x, y, b, N, i);
+  for (; i < i1; ++i) stencil_block<T, 1>(g, f, xr, o, x, row, N, i);
 }
 
 }  // namespace
 
 template <class T>
-void apply_band(const StencilView<T>& v, const T* x, T* y, const RowBlock& rows, const T* b) {
+void apply_band(const StencilView<T>& v, const T* x, const ApplyOut<T>& o, const RowBlock& rows) {
   const index nx = v.g.nx(), ny = v.g.ny(), N = v.g.nodes();
   for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
     for (index iy = rows.y_begin; iy < rows.y_end; ++iy)
-      sweep_row(v, nx, ny, N, iz, iy, x, y, b,
-                [&](const std::int32_t* f, const T* xr, T* yr, const T* br, index i0, index i1) {
-                  stencil_range<T>(v.groups, f, xr, yr, br, N, i0, i1);
-                });
+      sweep_row(v, nx, ny, N, iz, iy, x, o, [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
+        stencil_range<T>(v.groups, f, xr, o, x, row, N, i0, i1);
+      });
 }
 
 template <class T>

@@ -34,11 +34,11 @@ struct IsaKernels {
   const char* id;    // "x86-64-v4", "baseline": TRESCA_ISA's values
   const char* name;  // the instruction set its unit was compiled for: "AVX-512F", "AVX2+FMA", ...
   int vector_bytes;  // its vectors (simd.hpp)
-  // y = K x (b - K x with b != nullptr) over the node rows of `rows`, serially:
-  // the banded apply's work for one band (elasticity.cpp launches the bands)
-  void (*apply_band_d)(const StencilView<double>&, const double* x, double* y, const RowBlock& rows,
-                       const double* b);
-  void (*apply_band_f)(const StencilView<float>&, const float* x, float* y, const RowBlock& rows, const float* b);
+  // an apply of x (apply_out.hpp: K x, b - K x or a Chebyshev step) over the
+  // node rows of `rows`, serially: the banded apply's work for one band
+  // (elasticity.cpp launches the bands)
+  void (*apply_band_d)(const StencilView<double>&, const double* x, const ApplyOut<double>& out, const RowBlock& rows);
+  void (*apply_band_f)(const StencilView<float>&, const float* x, const ApplyOut<float>& out, const RowBlock& rows);
   // `iterations` rounds of kFmaChains independent FMA chains of this set's vectors on
   // every thread (perf/roofline's flop peak); returns a sum to check
   double (*fma_chains_d)(long iterations);

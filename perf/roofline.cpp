@@ -156,7 +156,7 @@ int main(int argc, char** argv) {
     add("residual b - Kx", dofs, nodes * kResidualCost,
         [&] { elasticity_apply(k, x.data(), y.data(), 0, g.nz(), b.data()); });
     add("bottom block", 3.0 * M, double(M) * kBottomBlockCost,
-        [&] { bottom_block_apply(g, 1e-9, B.data(), x.data(), y.data()); });
+        [&] { bottom_block_apply(g, B.data(), x.data(), operator_out(y.data())); });
     add("restriction", dofs, dofs * kRestrictCost, [&] { restrict_to_coarse(t, 3, x.data(), xc.data()); });
     add("prolongation (+=)", dofs, dofs * kProlongateCost, [&] { prolongate(t, 3, xc.data(), y.data(), true); });
     real sink = 0;

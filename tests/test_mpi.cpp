@@ -281,7 +281,7 @@ TEST(SlabMultigrid, BottomBlockCGMatchesTheWholeGridMultigrid) {
     index size() const override { return K.size(); }
     void apply(const real* x, real* y) const override {
       K.apply(x, y);
-      bottom_block_apply<real>(s.local, 1, Bl.data(), x, y);
+      bottom_block_apply<real>(s.local, Bl.data(), x, operator_out(y));
     }
     void update_ghosts(real* x) const override { K.update_ghosts(x); }
   } A(K, s, B, g);

@@ -40,28 +40,28 @@ const Field<float>& ElasticityOperator::block_in<float>() const {
 }
 
 template <class T>
-void ElasticityOperator::apply_rows(const T* x, T* y, const T* b, index z_begin, index z_end) const {
+void ElasticityOperator::apply_rows(const T* x, const ApplyOut<T>& out, index z_begin, index z_end) const {
   const GridDims& g = slab_.local;
   const index first = slab_.lo, last = slab_.lo + slab_.owned_rows();  // owned local rows
   {
     const double nodes = double(g.nx()) * double(last - first) * double(z_end - z_begin);
-    ScopedTimer t(Kernel::apply, nodes * in_precision<T>(b ? kResidualCost : kApplyCost));
-    elasticity_apply<T>(stencil_in<T>(), x, y, RowBlock{z_begin, z_end, first, last}, b);
+    ScopedTimer t(Kernel::apply, nodes * in_precision<T>(apply_cost(out)));
+    elasticity_apply<T>(stencil_in<T>(), x, out, RowBlock{z_begin, z_end, first, last});
   }
   const Field<T>& B = block_in<T>();
   if (!B.empty() && z_begin == 0 && z_end > 0) {  // B is 0 on ghost rows
     const double m = double(g.nx()) * double(g.ny());
     ScopedTimer t(Kernel::apply_boundary, m * in_precision<T>(kBottomBlockCost));
-    bottom_block_apply<T>(g, T(b ? -1 : 1), B.data(), x, y);
+    bottom_block_apply<T>(g, B.data(), x, out);
   }
-  if (z_begin == 0 && z_end == g.nz()) halo_.zero_ghosts(y);
+  if (z_begin == 0 && z_end == g.nz()) halo_.zero_ghosts(out.y);
 }
 
-template void ElasticityOperator::apply_rows<double>(const double*, double*, const double*, index, index) const;
-template void ElasticityOperator::apply_rows<float>(const float*, float*, const float*, index, index) const;
+template void ElasticityOperator::apply_rows<double>(const double*, const ApplyOut<double>&, index, index) const;
+template void ElasticityOperator::apply_rows<float>(const float*, const ApplyOut<float>&, index, index) const;
 
 void ElasticityOperator::apply_planes(const real* x, real* y, index z_begin, index z_end) const {
-  apply_rows<real>(x, y, nullptr, z_begin, z_end);
+  apply_rows<real>(x, operator_out(y), z_begin, z_end);
 }
 
 void ElasticityOperator::set_bottom_block(const std::vector<real>& B) {

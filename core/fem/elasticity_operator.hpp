@@ -36,14 +36,24 @@ class ElasticityOperator : public LinearOperator {
   ElasticityOperator(const Slab& s, unsigned faces, real E, real nu);
 
   index size() const override { return 3 * slab_.local.nodes(); }
-  void apply(const real* x, real* y) const override { apply_rows<real>(x, y, nullptr, 0, slab_.local.nz()); }
-  void apply(const float* x, float* y) const { apply_rows<float>(x, y, nullptr, 0, slab_.local.nz()); }
+  void apply(const real* x, real* y) const override { apply_rows<real>(x, operator_out(y), 0, slab_.local.nz()); }
+  void apply(const float* x, float* y) const { apply_rows<float>(x, operator_out(y), 0, slab_.local.nz()); }
   // y = (K + B) x on output planes [z_begin, z_end) of the owned rows;
   // other entries of y untouched
   void apply_planes(const real* x, real* y, index z_begin, index z_end) const;
   // r = b - (K + B) x, fused into the apply (no separate vector pass)
-  void residual(const real* b, const real* x, real* r) const { apply_rows<real>(x, r, b, 0, slab_.local.nz()); }
-  void residual(const float* b, const float* x, float* r) const { apply_rows<float>(x, r, b, 0, slab_.local.nz()); }
+  template <class T>
+  void residual(const T* b, const T* x, T* r) const {
+    apply_rows<T>(x, residual_out(b, r), 0, slab_.local.nz());
+  }
+  // a step of the multigrid smoother's Chebyshev iteration fused into the
+  // apply (kernels/apply_out.hpp): with r = b - (K + B) x never stored,
+  // d = s d + t dinv r (d not read where s == 0) and y = x + d; x's ghost
+  // rows as they are, y's zeroed, d's untouched
+  template <class T>
+  void chebyshev_step(const T* b, const T* x, T* y, const T* dinv, T* d, T s, T t) const {
+    apply_rows<T>(x, chebyshev_out(b, dinv, d, s, t, y), 0, slab_.local.nz());
+  }
   void update_ghosts(real* x) const override { halo_.exchange(x); }
   void update_ghosts(float* x) const { halo_.exchange(x); }
   template <class T>
@@ -79,7 +89,7 @@ class ElasticityOperator : public LinearOperator {
   const Field<T>& block_in() const;
   // y = (K + B) x (or b - (K + B) x) on planes [z_begin, z_end) of the owned rows
   template <class T>
-  void apply_rows(const T* x, T* y, const T* b, index z_begin, index z_end) const;
+  void apply_rows(const T* x, const ApplyOut<T>& out, index z_begin, index z_end) const;
 
   Slab slab_;
   unsigned global_faces_ = 0;

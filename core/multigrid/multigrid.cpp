@@ -311,8 +311,14 @@ template <class T>
 void Multigrid::smooth(int l, bool zero_guess) const {
   const Work<T>& w = work<T>()[l];
   ScopedTimer t(Kernel::smoother);
-  chebyshev_smooth<T>(levels_[l].A.size(), levels_[l].lmax, opt_.range, opt_.degree, zero_guess, w.dinv.data(), w.bp,
-                      w.xp, w.r.data(), w.d.data(), [&](T* x, T* r) { residual<T>(l, w.bp, x, r); });
+  const ElasticityOperator& A = levels_[l].A;
+  chebyshev_smooth<T>(
+      A.size(), levels_[l].lmax, opt_.range, opt_.degree, zero_guess, w.dinv.data(), w.bp, w.xp, w.r.data(), w.d.data(),
+      [&](T* x, T* r) { residual<T>(l, w.bp, x, r); },
+      [&](T* x, T* y, T s, T t) {
+        A.update_ghosts(x);
+        A.chebyshev_step(w.bp, x, y, w.dinv.data(), w.d.data(), s, t);
+      });
 }
 
 template <class T>
