@@ -22,6 +22,8 @@
 // p + j, so the CPU's explicit vectors and the device's scalar lanes share
 // this one definition.
 #pragma once
+#include <type_traits>
+
 #include "types.hpp"
 
 namespace tresca {
@@ -63,17 +65,58 @@ inline void store_as(T* p, U v) {
   *reinterpret_cast<U*>(p) = v;
 }
 
-// entry j's value v of an apply of x
-template <class T, class U>
-inline void put(const ApplyOut<T>& o, const T* x, index j, U v) {
-  if (!o.dinv) {
-    store_as<U>(o.y + j, o.b ? load_as<U>(o.b + j) - v : v);
-    return;
+// The four things put() can do, known when the kernel is compiled: each
+// apply dispatches once on kind(out), so its inner loops carry no branch on
+// it (with_kind).
+enum class OutKind { value, residual, step_first, step };
+template <class T>
+constexpr OutKind kind(const ApplyOut<T>& o) {
+  return o.dinv ? (o.s != 0 ? OutKind::step : OutKind::step_first) : o.b ? OutKind::residual : OutKind::value;
+}
+template <OutKind K>
+using Kind = std::integral_constant<OutKind, K>;
+// f(Kind<kind(o)>{})
+template <class T, class F>
+inline void with_kind(const ApplyOut<T>& o, const F& f) {
+  switch (kind(o)) {
+    case OutKind::value: return f(Kind<OutKind::value>{});
+    case OutKind::residual: return f(Kind<OutKind::residual>{});
+    case OutKind::step_first: return f(Kind<OutKind::step_first>{});
+    case OutKind::step: return f(Kind<OutKind::step>{});
   }
-  U dn = o.t * load_as<U>(o.dinv + j) * (load_as<U>(o.b + j) - v);
-  if (o.s != 0) dn += o.s * load_as<U>(o.d + j);
-  store_as<U>(o.d + j, dn);
-  store_as<U>(o.y + j, load_as<U>(x + j) + dn);
+}
+
+// entry j's value v of an apply of x (K = kind(o); o by value: its
+// pointers stay in registers across the stores)
+template <OutKind K, class T, class U>
+inline void put(const ApplyOut<T> o, const T* x, index j, U v) {
+  if constexpr (K == OutKind::value) {
+    store_as<U>(o.y + j, v);
+  } else if constexpr (K == OutKind::residual) {
+    store_as<U>(o.y + j, load_as<U>(o.b + j) - v);
+  } else {
+    U dn = o.t * load_as<U>(o.dinv + j) * (load_as<U>(o.b + j) - v);
+    if constexpr (K == OutKind::step) dn += o.s * load_as<U>(o.d + j);
+    store_as<U>(o.d + j, dn);
+    store_as<U>(o.y + j, load_as<U>(x + j) + dn);
+  }
+}
+
+// The same for a vector U whose lanes where `keep` is true were put before
+// (the banded apply's overlapping last vector of a run): those lanes of y
+// (and d) are stored back as they are, so each entry is put once.
+template <OutKind K, class T, class U, class Mask>
+inline void put_lanes(const ApplyOut<T> o, const T* x, index j, U v, Mask keep) {
+  const U y_was = load_as<U>(o.y + j);
+  if constexpr (K == OutKind::value || K == OutKind::residual) {
+    store_as<U>(o.y + j, keep ? y_was : (K == OutKind::value ? v : load_as<U>(o.b + j) - v));
+  } else {
+    U dn = o.t * load_as<U>(o.dinv + j) * (load_as<U>(o.b + j) - v);
+    if constexpr (K == OutKind::step) dn += o.s * load_as<U>(o.d + j);
+    const U d_was = load_as<U>(o.d + j);
+    store_as<U>(o.d + j, keep ? d_was : dn);
+    store_as<U>(o.y + j, keep ? y_was : load_as<U>(x + j) + dn);
+  }
 }
 
 // entry j as if put() had been given v + w (the bottom block's term, added

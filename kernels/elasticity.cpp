@@ -196,23 +196,27 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
   const index z0 = rows.z_begin, y0 = rows.y_begin;
   const index nz = rows.z_end - rows.z_begin, nyr = rows.y_end - rows.y_begin;
   const double nodes = double(nx) * double(nz) * double(nyr);
-  for_each_block(nz, nyr, nodes * in_precision<T>(apply_cost(out)), [=](index jz, index jy) {
-    sweep_row(k, nx, ny, N, z0 + jz, y0 + jy, x, out, [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
-                const StencilGroupT<T>*q0 = k.groups + f[0], *q1 = k.groups + f[7];
+  with_kind(out, [&](auto kind) {
+    constexpr OutKind K = decltype(kind)::value;
+    for_each_block(nz, nyr, nodes * in_precision<T>(apply_cost(out)), [=](index jz, index jy) {
+      sweep_row<K>(k, nx, ny, N, z0 + jz, y0 + jy, x, out,
+                   [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
+                     const StencilGroupT<T>*q0 = k.groups + f[0], *q1 = k.groups + f[7];
 #pragma omp simd
-                for (index i = i0; i < i1; ++i) {
-                  T acc0 = 0, acc1 = 0, acc2 = 0;
-                  for (const StencilGroupT<T>* q = q0; q != q1; ++q) {
-                    const T v = xr[i + q->off];
-                    acc0 += q->c[0] * v;
-                    acc1 += q->c[1] * v;
-                    acc2 += q->c[2] * v;
-                  }
-                  put(out, x, row + i, acc0);
-                  put(out, x, N + row + i, acc1);
-                  put(out, x, 2 * N + row + i, acc2);
-                }
-              });
+                     for (index i = i0; i < i1; ++i) {
+                       T acc0 = 0, acc1 = 0, acc2 = 0;
+                       for (const StencilGroupT<T>* q = q0; q != q1; ++q) {
+                         const T v = xr[i + q->off];
+                         acc0 += q->c[0] * v;
+                         acc1 += q->c[1] * v;
+                         acc2 += q->c[2] * v;
+                       }
+                       put<K>(out, x, row + i, acc0);
+                       put<K>(out, x, N + row + i, acc1);
+                       put<K>(out, x, 2 * N + row + i, acc2);
+                     }
+                   });
+    });
   });
 }
 template void elasticity_apply_rows<double>(const StencilView<double>&, const double*, const ApplyOut<double>&,

@@ -47,8 +47,8 @@ inline void accumulate(const StencilGroupT<T>* g, const StencilGroupT<T>* ge, co
 // components of one stencil (f = first + 7*s), handed to put() (apply_out.hpp);
 // xr = x + row. The first `done` entries are computed but not put (they
 // were: a Chebyshev step's put may not run twice on an entry).
-template <class T, int W>
-inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, const T* xr, const ApplyOut<T>& o,
+template <OutKind K, class T, int W>
+inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, const T* xr, const ApplyOut<T> o,
                           const T* x, index row, index N, index i, int done = 0) {
   using V = Vec<T>;
   constexpr int kLanes = Simd<T>::lanes;
@@ -58,7 +58,7 @@ inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, cons
       T acc[3] = {0, 0, 0};
       for (const StencilGroupT<T>* q = g + f[0]; q != g + f[7]; ++q)
         for (int a = 0; a < 3; ++a) acc[a] += q->c[a] * xr[i + l + q->off];
-      for (int a = 0; a < 3; ++a) put(o, x, a * N + row + i + l, acc[a]);
+      for (int a = 0; a < 3; ++a) put<K>(o, x, a * N + row + i + l, acc[a]);
     }
   } else {
     constexpr int NV = W / kLanes;
@@ -73,32 +73,46 @@ inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, cons
     accumulate<T, NV, 6>(g + f[5], g + f[6], xi, a0, a1, a2);
     accumulate<T, NV, 7>(g + f[6], g + f[7], xi, a0, a1, a2);
     V* out[3] = {a0, a1, a2};
-    for (int a = 0; a < 3; ++a) {
-      if (done > 0) {  // (NV = 1: the run's last, overlapping vector)
-        for (int lane = done; lane < kLanes; ++lane) put(o, x, a * N + row + i + lane, out[a][0][lane]);
-        continue;
-      }
-      for (int l = 0; l < NV; ++l) put(o, x, a * N + row + i + kLanes * l, out[a][l]);
+    if (done > 0) {  // (NV = 1: the run's last, overlapping vector)
+      V lane;
+      for (int l = 0; l < kLanes; ++l) lane[l] = T(l);
+      const auto keep = lane < T(done);
+      for (int a = 0; a < 3; ++a) put_lanes<K>(o, x, a * N + row + i, out[a][0], keep);
+      return;
     }
+    for (int a = 0; a < 3; ++a)
+      for (int l = 0; l < NV; ++l) put<K>(o, x, a * N + row + i + kLanes * l, out[a][l]);
   }
 }
 
-template <class T>
-inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* xr, const ApplyOut<T>& o,
+template <OutKind K, class T>
+inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* xr, const ApplyOut<T> o,
                           const T* x, index row, index N, index i0, index i1) {
   constexpr int kLanes = Simd<T>::lanes;
   // three vectors per block: 9 accumulators + 3 inputs fit the 16 registers of
   // SSE/AVX2 (and AVX-512's 32); the width is measured (perf/RESULTS.md §0i)
   constexpr int kW = 3 * kLanes;
   index i = i0;
-  for (; i + kW <= i1; i += kW) stencil_block<T, kW>(g, f, xr, o, x, row, N, i);
-  for (; i + kLanes <= i1; i += kLanes) stencil_block<T, kLanes>(g, f, xr, o, x, row, N, i);
+  for (; i + kW <= i1; i += kW) {
+    if constexpr (K == OutKind::step || K == OutKind::step_first) {
+      constexpr int kLine = 64 / sizeof(T);
+      for (int a = 0; a < 3; ++a)
+        for (int l = 0; l < kW; l += kLine) {
+          const index j = a * N + row + i + kW + l;
+          __builtin_prefetch(o.b + j);
+          __builtin_prefetch(o.dinv + j);
+          if constexpr (K == OutKind::step) __builtin_prefetch(o.d + j, 1);
+        }
+    }
+    stencil_block<K, T, kW>(g, f, xr, o, x, row, N, i);
+  }
+  for (; i + kLanes <= i1; i += kLanes) stencil_block<K, T, kLanes>(g, f, xr, o, x, row, N, i);
   if (i < i1 && i1 - i0 >= kLanes) {
     // finish with one overlapping vector: computes a few entries again, puts the new ones
-    stencil_block<T, kLanes>(g, f, xr, o, x, row, N, i1 - kLanes, int(i - (i1 - kLanes)));
+    stencil_block<K, T, kLanes>(g, f, xr, o, x, row, N, i1 - kLanes, int(i - (i1 - kLanes)));
     return;
   }
-  for (; i < i1; ++i) stencil_block<T, 1>(g, f, xr, o, x, row, N, i);
+  for (; i < i1; ++i) stencil_block<K, T, 1>(g, f, xr, o, x, row, N, i);
 }
 
 }  // namespace
@@ -106,11 +120,14 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
 template <class T>
 void apply_band(const StencilView<T>& v, const T* x, const ApplyOut<T>& o, const RowBlock& rows) {
   const index nx = v.g.nx(), ny = v.g.ny(), N = v.g.nodes();
-  for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
-    for (index iy = rows.y_begin; iy < rows.y_end; ++iy)
-      sweep_row(v, nx, ny, N, iz, iy, x, o, [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
-        stencil_range<T>(v.groups, f, xr, o, x, row, N, i0, i1);
-      });
+  with_kind(o, [&](auto kind) {
+    constexpr OutKind K = decltype(kind)::value;
+    for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
+      for (index iy = rows.y_begin; iy < rows.y_end; ++iy)
+        sweep_row<K>(v, nx, ny, N, iz, iy, x, o, [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
+          stencil_range<K, T>(v.groups, f, xr, o, x, row, N, i0, i1);
+        });
+  });
 }
 
 template <class T>

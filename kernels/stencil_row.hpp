@@ -19,14 +19,14 @@ namespace {
 enum : std::uint8_t { kHasL = 1, kHasR = 2, kDropL = 4, kDropR = 8, kSelf = 16 };
 
 // One node row (iz, iy) of an apply of x (apply_out.hpp: y = K x, b - K x
-// or a Chebyshev step) over its x-runs: a run of nodes on a constrained face
+// or a Chebyshev step; K = kind(out)) over its x-runs: a run of nodes on a constrained face
 // (or the whole row on one) is the identity there (v = x); every other run
 // hands its stencil (f = first + 7 s), x offset to the row's first node, and
 // that node's index to run(f, xr, row, i0, i1). The banded apply and its row
 // form differ only in `run` and in how rows are launched.
-template <class T, class Run>
+template <OutKind K, class T, class Run>
 inline void sweep_row(const StencilView<T>& k, index nx, index ny, index N, index iz, index iy, const T* x,
-                      const ApplyOut<T>& out, const Run& run) {
+                      const ApplyOut<T> out, const Run& run) {
   const std::uint8_t cy = k.cls[1][iy], cz = k.cls[2][iz];
   const index row = nx * (iy + ny * iz);
   const bool row_fixed = (cy & kSelf) || (cz & kSelf);
@@ -37,7 +37,7 @@ inline void sweep_row(const StencilView<T>& k, index nx, index ny, index N, inde
     if (row_fixed || (cx & kSelf)) {
       for (int a = 0; a < 3; ++a)
 #pragma omp simd
-        for (index i = i0; i < i1; ++i) put(out, x, a * N + row + i, xr[a * N + i]);
+        for (index i = i0; i < i1; ++i) put<K>(out, x, a * N + row + i, xr[a * N + i]);
       continue;
     }
     run(k.first + 7 * k.slot[(cx * 32 + cy) * 32 + cz], xr, row, i0, i1);

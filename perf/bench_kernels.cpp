@@ -87,6 +87,37 @@ BENCHMARK_TEMPLATE(BM_Apply, double, Run::ref)->Name("ApplyRef")->DenseRange(6, 
 BENCHMARK_TEMPLATE(BM_Apply, double, Run::device)->Name("DeviceApply")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_Apply, float, Run::device)->Name("DeviceApplyFloat")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
 
+// One Chebyshev step of the smoother on a level's vectors, in the V-cycle's
+// float: fused into the apply (kernels/apply_out.hpp: the sweep writes d and
+// the new iterate) against the residual and the in-place update it replaced
+// (two sweeps, r written and read back). Bytes: the fused model,
+// kChebStepCost, for both, so their GB/s compare as times do.
+template <bool kFused>
+void BM_ChebStep(benchmark::State& st) {
+  using T = float;
+  const Problem P = make_problem(spec_for_level(int(st.range(0))));
+  const ElasticityStencil k = build_elasticity_stencil(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+  const ElasticityStencilT<T> kt = stencil_in_precision<T>(k);
+  const index n = k.size();
+  Field<T> x = placed_field<T>(ramp(n)), y(n), b = placed_field<T>(ramp(n)), d(n), dinv(n);
+  fill<T>(n, T(1e-3), dinv.data());
+  const RowBlock all{0, P.grid.nz(), 0, P.grid.ny()};
+  for (auto _ : st) {
+    if constexpr (kFused) {
+      elasticity_apply<T>(kt, x.data(), chebyshev_out<T>(b.data(), dinv.data(), d.data(), 0.5f, 0.25f, y.data()), all);
+    } else {
+      elasticity_apply<T>(kt, x.data(), y.data(), all, b.data());
+      cheb_update<T>(n, 0.5f, 0.25f, dinv.data(), y.data(), d.data(), x.data());
+    }
+    benchmark::DoNotOptimize(y.data());
+    benchmark::ClobberMemory();
+  }
+  const Cost c = in_precision<T>(kChebStepCost);
+  set_rates(st, double(P.dofs()), c.bytes / 3, c.flops / 3);
+}
+BENCHMARK_TEMPLATE(BM_ChebStep, true)->Name("ChebStepFused")->DenseRange(8, 12, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_ChebStep, false)->Name("ChebStepUnfused")->DenseRange(8, 12, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
 template <Run kRun>
 void BM_VCycle(benchmark::State& st) {
   const Problem P = make_problem(spec_for_level(int(st.range(0))));
