@@ -46,6 +46,9 @@
 // Cost per V-cycle on a level with n dofs: (2*degree) applies of A, plus
 // residual apply, one restriction and one prolongation: about
 // (2*degree+1) * 306/3 + 20 flops per dof; the hierarchy adds about 1/7.
+// The smoother's steps after the first run fused into the apply, in pairs
+// (smoothing.hpp, kernels/apply_out.hpp): no residual vector written and
+// read back, about 30 % less memory traffic a step.
 #pragma once
 #include <Eigen/SparseCholesky>
 #include <functional>
