@@ -18,9 +18,9 @@
 // 7 streams instead of 10 (RESULTS.md §0p). Where s == 0 (the first step)
 // d is not read, so it may hold anything.
 //
-// U is T or a vector of T (simd.hpp): put() and add() load and store U at
-// p + j, so the CPU's explicit vectors and the device's scalar lanes share
-// this one definition.
+// U is T or a vector of T (simd.hpp): put(), put_lanes() and add() load and
+// store U at p + j, so the CPU's explicit vectors and the device's scalar
+// lanes share this one definition.
 #pragma once
 #include <type_traits>
 
@@ -108,8 +108,10 @@ inline void put(const ApplyOut<T> o, const T* x, index j, U v) {
 template <OutKind K, class T, class U, class Mask>
 inline void put_lanes(const ApplyOut<T> o, const T* x, index j, U v, Mask keep) {
   const U y_was = load_as<U>(o.y + j);
-  if constexpr (K == OutKind::value || K == OutKind::residual) {
-    store_as<U>(o.y + j, keep ? y_was : (K == OutKind::value ? v : load_as<U>(o.b + j) - v));
+  if constexpr (K == OutKind::value) {
+    store_as<U>(o.y + j, keep ? y_was : v);
+  } else if constexpr (K == OutKind::residual) {
+    store_as<U>(o.y + j, keep ? y_was : load_as<U>(o.b + j) - v);
   } else {
     U dn = o.t * load_as<U>(o.dinv + j) * (load_as<U>(o.b + j) - v);
     if constexpr (K == OutKind::step) dn += o.s * load_as<U>(o.d + j);

@@ -95,6 +95,9 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
   index i = i0;
   for (; i + kW <= i1; i += kW) {
     if constexpr (K == OutKind::step || K == OutKind::step_first) {
+      // the next block's lines of b, dinv and d (64-byte lines): the step's
+      // epilogue otherwise misses on them in a burst after the block's
+      // arithmetic (15 % slower than two sweeps on one thread, RESULTS.md §0p)
       constexpr int kLine = 64 / sizeof(T);
       for (int a = 0; a < 3; ++a)
         for (int l = 0; l < kW; l += kLine) {

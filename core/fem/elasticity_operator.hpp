@@ -87,7 +87,8 @@ class ElasticityOperator : public LinearOperator {
   const ElasticityStencilT<T>& stencil_in() const;
   template <class T>
   const Field<T>& block_in() const;
-  // y = (K + B) x (or b - (K + B) x) on planes [z_begin, z_end) of the owned rows
+  // an apply of K + B to x, written as `out` says (kernels/apply_out.hpp), on
+  // planes [z_begin, z_end) of the owned rows
   template <class T>
   void apply_rows(const T* x, const ApplyOut<T>& out, index z_begin, index z_end) const;
 
