@@ -86,6 +86,8 @@ inline void with_kind(const ApplyOut<T>& o, const F& f) {
   }
 }
 
+constexpr bool writes_d(OutKind k) { return k == OutKind::step_first || k == OutKind::step; }
+
 // entry j's value v of an apply of x (K = kind(o); o by value: its
 // pointers stay in registers across the stores)
 template <OutKind K, class T, class U>
@@ -107,33 +109,31 @@ inline void put(const ApplyOut<T> o, const T* x, index j, U v) {
 // (and d) are stored back as they are, so each entry is put once.
 template <OutKind K, class T, class U, class Mask>
 inline void put_lanes(const ApplyOut<T> o, const T* x, index j, U v, Mask keep) {
-  const U y_was = load_as<U>(o.y + j);
-  if constexpr (K == OutKind::value) {
-    store_as<U>(o.y + j, keep ? y_was : v);
-  } else if constexpr (K == OutKind::residual) {
-    store_as<U>(o.y + j, keep ? y_was : load_as<U>(o.b + j) - v);
-  } else {
-    U dn = o.t * load_as<U>(o.dinv + j) * (load_as<U>(o.b + j) - v);
-    if constexpr (K == OutKind::step) dn += o.s * load_as<U>(o.d + j);
-    const U d_was = load_as<U>(o.d + j);
-    store_as<U>(o.d + j, keep ? d_was : dn);
-    store_as<U>(o.y + j, keep ? y_was : load_as<U>(x + j) + dn);
-  }
+  const U y_was = load_as<U>(o.y + j), d_was = writes_d(K) ? load_as<U>(o.d + j) : U{};
+  put<K>(o, x, j, v);
+  store_as<U>(o.y + j, keep ? y_was : load_as<U>(o.y + j));
+  if constexpr (writes_d(K)) store_as<U>(o.d + j, keep ? d_was : load_as<U>(o.d + j));
 }
 
 // entry j as if put() had been given v + w (the bottom block's term, added
 // after the stencil's)
-template <class T, class U>
-inline void add(const ApplyOut<T>& o, index j, U w) {
-  if (!o.dinv) {
-    store_as<U>(o.y + j, o.b ? load_as<U>(o.y + j) - w : load_as<U>(o.y + j) + w);
-    return;
+template <OutKind K, class T, class U>
+inline void add(const ApplyOut<T> o, index j, U w) {
+  if constexpr (K == OutKind::value) {
+    store_as<U>(o.y + j, load_as<U>(o.y + j) + w);
+  } else if constexpr (K == OutKind::residual) {
+    store_as<U>(o.y + j, load_as<U>(o.y + j) - w);
+  } else {
+    const U c = o.t * load_as<U>(o.dinv + j) * w;
+    store_as<U>(o.d + j, load_as<U>(o.d + j) - c);
+    store_as<U>(o.y + j, load_as<U>(o.y + j) - c);
   }
-  const U c = o.t * load_as<U>(o.dinv + j) * w;
-  store_as<U>(o.d + j, load_as<U>(o.d + j) - c);
-  store_as<U>(o.y + j, load_as<U>(o.y + j) - c);
 }
 
 }  // namespace
+
+// Cost per node of a Chebyshev step beyond the residual's: reads dinv and d,
+// writes d (3 dofs, double), 6 flops a dof
+constexpr Cost kChebStepExtraCost{72, 18};
 
 }  // namespace tresca

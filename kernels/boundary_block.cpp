@@ -8,12 +8,15 @@ template <class T>
 void bottom_block_apply(const GridDims& g, const T* B, const T* x, const ApplyOut<T>& out) {
   const index M = g.nx() * g.ny(), N = g.nodes();
   const T *bxx = B, *bxy = B + M, *byy = B + 2 * M, *bzz = B + 3 * M;
-  const Cost step = out.dinv ? Cost{72, 18} : Cost{};  // the Chebyshev step's dinv and d
-  for_each_entry(M, in_precision<T>(kBottomBlockCost + step), [=](index n) {
-    const T ux = x[n], uy = x[N + n], uz = x[2 * N + n];
-    add(out, n, bxx[n] * ux + bxy[n] * uy);
-    add(out, N + n, bxy[n] * ux + byy[n] * uy);
-    add(out, 2 * N + n, bzz[n] * uz);
+  const Cost step = out.dinv ? kChebStepExtraCost : Cost{};  // the Chebyshev step's dinv and d
+  with_kind(out, [&](auto kind) {
+    constexpr OutKind K = decltype(kind)::value;
+    for_each_entry(M, in_precision<T>(kBottomBlockCost + step), [=](index n) {
+      const T ux = x[n], uy = x[N + n], uz = x[2 * N + n];
+      add<K>(out, n, bxx[n] * ux + bxy[n] * uy);
+      add<K>(out, N + n, bxy[n] * ux + byy[n] * uy);
+      add<K>(out, 2 * N + n, bzz[n] * uz);
+    });
   });
 }
 template void bottom_block_apply<double>(const GridDims&, const double*, const double*, const ApplyOut<double>&);

@@ -90,11 +90,11 @@ ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& k);
 // Cost per output node (double fields; in_precision<float> halves the bytes):
 // y = K x reads x and writes y (3 components each; neighbour rows come from
 // cache), 153 FMAs; the residual b - K x also reads b.
-// The smoother's Chebyshev step (apply_out.hpp) reads dinv and d and writes
-// d and the new iterate (in place of r): 3 x 24 bytes more, 6 flops a dof.
+// The smoother's Chebyshev step (apply_out.hpp) writes the new iterate in
+// place of r and also reads dinv and d and writes d (kChebStepExtraCost).
 constexpr Cost kApplyCost{48, 306};
 constexpr Cost kResidualCost{72, 309};
-constexpr Cost kChebStepCost{144, 327};
+constexpr Cost kChebStepCost = kResidualCost + kChebStepExtraCost;
 template <class T>
 constexpr Cost apply_cost(const ApplyOut<T>& out) {
   return out.dinv ? kChebStepCost : out.b ? kResidualCost : kApplyCost;
