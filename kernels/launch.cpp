@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -37,9 +38,37 @@ bool offload_built() {
 bool launch_on_device() { return on_device; }
 
 std::atomic<long long> detail::launches[3];
+std::atomic<long long> detail::launch_ns[2];
+namespace {
+constexpr int kSizes = LaunchCounts::kSizes;
+std::atomic<long long> launches_by_size[kSizes], launch_ns_by_size[kSizes];
+std::atomic<double> work_by_size[kSizes];
+}  // namespace
+
+void detail::count_threaded_launch(double work, long long ns) {
+  int k = 0;
+  while (k + 1 < kSizes && work >= kParallelWork * std::pow(10.0, k + 1)) ++k;
+  launches[0].fetch_add(1, std::memory_order_relaxed);
+  launch_ns[0].fetch_add(ns, std::memory_order_relaxed);
+  launches_by_size[k].fetch_add(1, std::memory_order_relaxed);
+  launch_ns_by_size[k].fetch_add(ns, std::memory_order_relaxed);
+  double w = work_by_size[k].load(std::memory_order_relaxed);  // (one caller at a time: no lost update to fear)
+  work_by_size[k].store(w + work, std::memory_order_relaxed);
+}
 
 LaunchCounts launch_counts() {
-  return {detail::launches[0].load(), detail::launches[1].load(), detail::launches[2].load()};
+  LaunchCounts c;
+  c.threaded = detail::launches[0].load();
+  c.one_thread = detail::launches[1].load();
+  c.device = detail::launches[2].load();
+  c.threaded_seconds = 1e-9 * double(detail::launch_ns[0].load());
+  c.one_thread_seconds = 1e-9 * double(detail::launch_ns[1].load());
+  for (int k = 0; k < kSizes; ++k) {
+    c.by_size[k] = launches_by_size[k].load();
+    c.by_size_seconds[k] = 1e-9 * double(launch_ns_by_size[k].load());
+    c.by_size_work[k] = work_by_size[k].load();
+  }
+  return c;
 }
 
 void set_launch_on_device(bool on) {

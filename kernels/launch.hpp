@@ -26,6 +26,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -101,19 +102,52 @@ constexpr int kScratchTeams = 1024;
 // The launches so far, by where they ran: the fork/join census of
 // `--profile` and bench_kernels. A threaded launch is one OpenMP parallel
 // region (a fork, a join and its barrier); a one-thread launch ran on the
-// calling thread, its work below worth_threads.
+// calling thread, its work below worth_threads. The seconds are wall time
+// on the calling thread from each launch's start to its end: what is not
+// threaded ran on one thread (one-thread launches, and the code between
+// launches), the part that more threads do not shorten. The threaded
+// launches are also counted by their modelled work (bytes + flops), in
+// decades from kParallelWork: where small regions cost more than their
+// work, fork/join and waking the threads is what they pay for.
 struct LaunchCounts {
   long long threaded = 0, one_thread = 0, device = 0;
+  double threaded_seconds = 0, one_thread_seconds = 0;
+  static constexpr int kSizes = 3;                     // work below 10x, 100x kParallelWork, and more
+  long long by_size[kSizes] = {};
+  double by_size_seconds[kSizes] = {}, by_size_work[kSizes] = {};
 };
 LaunchCounts launch_counts();
 namespace detail {
 extern std::atomic<long long> launches[3];  // threaded, one_thread, device
-// worth_threads(work), the launch counted as what it will be
-inline bool counted_host_launch(Cost work) {
-  const bool threads = worth_threads(work);
-  launches[threads ? 0 : 1].fetch_add(1, std::memory_order_relaxed);
-  return threads;
+extern std::atomic<long long> launch_ns[2];  // threaded, one_thread
+inline long long now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
 }
+void count_threaded_launch(double work, long long ns);  // in its size class
+// One host launch: whether it starts threads (worth_threads(work)), counted
+// as what it is and timed until it goes out of scope. Host launches are
+// made from the driver's thread only (none nests in another).
+class HostLaunch {
+ public:
+  explicit HostLaunch(Cost work) : threads(worth_threads(work)), work_(work.bytes + work.flops), t0_(now_ns()) {}
+  ~HostLaunch() {
+    const long long ns = now_ns() - t0_;
+    if (threads)
+      count_threaded_launch(work_, ns);
+    else {
+      launches[1].fetch_add(1, std::memory_order_relaxed);
+      launch_ns[1].fetch_add(ns, std::memory_order_relaxed);
+    }
+  }
+  HostLaunch(const HostLaunch&) = delete;
+  HostLaunch& operator=(const HostLaunch&) = delete;
+  const bool threads;
+
+ private:
+  double work_;
+  long long t0_;
+};
 inline void counted_device_launch() { launches[2].fetch_add(1, std::memory_order_relaxed); }
 }  // namespace detail
 
@@ -138,7 +172,8 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
     return;
   }
 #endif
-#pragma omp parallel for simd schedule(static) if (parallel : detail::counted_host_launch(double(n) * per_entry))
+  const detail::HostLaunch launch(double(n) * per_entry);
+#pragma omp parallel for simd schedule(static) if (parallel : launch.threads)
   for (index i = 0; i < n; ++i) body(i);
 }
 
@@ -160,7 +195,8 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
 // occupancy, of every kernel (perf/offload_registers.py, RESULTS.md §0n).
 template <class Body>
 inline void for_each_host_block(index n, Cost work, const Body& body) {
-#pragma omp parallel for schedule(static) if (detail::counted_host_launch(work))
+  const detail::HostLaunch launch(work);
+#pragma omp parallel for schedule(static) if (launch.threads)
   for (index b = 0; b < n; ++b) body(b);
 }
 
@@ -198,7 +234,8 @@ inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
     return;
   }
 #endif
-#pragma omp parallel for collapse(2) schedule(static) if (detail::counted_host_launch(work))
+  const detail::HostLaunch launch(work);
+#pragma omp parallel for collapse(2) schedule(static) if (launch.threads)
   for (index j = 0; j < n1; ++j)
     for (index i = 0; i < n0; ++i) body(j, i);
 }
@@ -221,7 +258,8 @@ inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost 
     return;
   }
 #endif
-#pragma omp parallel if (detail::counted_host_launch(work))
+  const detail::HostLaunch launch(work);
+#pragma omp parallel if (launch.threads)
   {
     std::vector<T> buffer(scratch);
     T* s = buffer.data();
@@ -266,8 +304,11 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
     }
   } else
 #endif
-#pragma omp parallel for schedule(static) if (detail::counted_host_launch(double(n) * per_entry))
-  for (index b = 0; b < nb; ++b) part[b] = block(b * width, std::min(n, (b + 1) * width));
+  {
+    const detail::HostLaunch launch(double(n) * per_entry);
+#pragma omp parallel for schedule(static) if (launch.threads)
+    for (index b = 0; b < nb; ++b) part[b] = block(b * width, std::min(n, (b + 1) * width));
+  }
   real s = 0;
   for (index b = 0; b < nb; ++b) s += part[b];
   return s;

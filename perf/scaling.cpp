@@ -26,6 +26,7 @@
 #include "core/util/profile.hpp"
 #include "core/contact/run.hpp"
 #include "kernels/isa.hpp"
+#include "kernels/launch.hpp"
 
 using namespace tresca;
 
@@ -183,7 +184,8 @@ int main(int argc, char** argv) {
     }
     std::printf("# STREAM triad (3 x 128 MiB, best of 5) with");
     for (size_t k = 0; k < threads.size(); ++k) std::printf(" %d: %.1f GB/s%s", threads[k], triad[k] / 1e9, k + 1 < threads.size() ? "," : "\n");
-    std::printf("# speedup: over the first thread count; bw-ideal: the triad's ratio; eff: speedup / bw-ideal\n");
+    std::printf("# speedup: over the first thread count; bw-ideal: the triad's ratio; eff: speedup / bw-ideal;\n"
+                "# 1-thread: seconds of the total outside parallel regions (no thread count shortens them)\n");
     std::printf("# fmv: fine-grid matvec equivalents (the solvers' work counts); fmv K_ii: one MG-CG solve of K_ii to 1e-10\n");
     std::printf("# nested iteration %s; newton, outer, inner, S-app, fmv/step: this mesh; fmv nest: the coarser meshes;\n"
                 "# fmv/solve: all of it (coarser meshes, |b~|, Newton, final check and recovery); condense: the loose |b~|\n",
@@ -193,7 +195,7 @@ int main(int argc, char** argv) {
     std::printf("%5s %3s %10s %8s %8s %8s %8s %8s %8s %4s %6s %6s %6s %6s %8s %8s %9s %8s %6s %8s %7s", "level", "thr",
                 "dofs", "nested", "setup", "condense", "solve", "recover", "total", "fp", "newton", "outer", "inner", "S-app",
                 "fmv/step", "fmv nest", "fmv/solve", "fmv K_ii", "ratio", "peak GB", "speedup");
-    std::printf(" %8s %5s\n", "bw-ideal", "eff");
+    std::printf(" %8s %5s %8s\n", "bw-ideal", "eff", "1-thread");
     if (repeat > 1)
       std::printf("# each row: the median of %lld solves by total time; [min-max] of their totals after it\n", repeat);
     bool all_converged = true;
@@ -221,7 +223,7 @@ int main(int argc, char** argv) {
         o.nested = nested;
         o.friction = friction;
         // every repetition's row and summary; the median's are kept
-        std::vector<double> totals;
+        std::vector<double> totals, serial;
         std::vector<std::string> lines, reasons;
         std::vector<Json> summaries;
         for (long long rep = 0; rep < repeat; ++rep) {
@@ -243,6 +245,7 @@ int main(int argc, char** argv) {
           j["contact_over_linear"] = R.fine_matvecs_total / fmv_linear;
           summaries.push_back(std::move(j));
           totals.push_back(R.times.total);
+          serial.push_back(std::max(0.0, R.times.total - launches_since_reset().threaded_seconds));
         }
         std::vector<size_t> order(totals.size());
         for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -252,7 +255,7 @@ int main(int argc, char** argv) {
         if (T == threads.front()) t_first = total;
         const double speedup = t_first / total, bw_ideal = triad[k] / triad.front();
         char tail[96];
-        std::snprintf(tail, sizeof tail, " %7.2f %8.2f %5.2f", speedup, bw_ideal, speedup / bw_ideal);
+        std::snprintf(tail, sizeof tail, " %7.2f %8.2f %5.2f %8.3f", speedup, bw_ideal, speedup / bw_ideal, serial[med]);
         std::string range;
         if (repeat > 1) {
           char r[64];

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "core/util/profile.hpp"
 #include "kernels/launch.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"
@@ -62,6 +63,77 @@ TEST(VectorOps, LaunchesAreCountedByWhereTheyRan) {
   EXPECT_EQ(c.threaded - b.threaded, 0);
   EXPECT_EQ(c.one_thread - b.one_thread, 2);
   EXPECT_EQ(c.device, a.device);
+}
+
+// ... and timed: a threaded launch's wall time in threaded_seconds, in the
+// size class of its modelled work; a one-thread launch's in one_thread_seconds
+TEST(VectorOps, LaunchesAreTimedAndSortedBySize) {
+  const double per_entry = kAxpyCost.bytes + kAxpyCost.flops;
+  const index largest = index(3e7 / per_entry) + 1;
+  const auto x = test::random_vector(largest, 13);
+  auto y = test::random_vector(largest, 14);
+  for (int k = 0; k < LaunchCounts::kSizes; ++k) {
+    const index n = index(1.5 * kParallelWork * std::pow(10.0, k) / per_entry);  // inside class k
+    const LaunchCounts a = launch_counts();
+    const double t0 = wall_time();
+    axpy(n, 0.5, x.data(), y.data());
+    const double wall = wall_time() - t0;
+    const LaunchCounts b = launch_counts();
+    for (int j = 0; j < LaunchCounts::kSizes; ++j) {
+      EXPECT_EQ(b.by_size[j] - a.by_size[j], j == k ? 1 : 0) << "launch of " << n << " entries, class " << j;
+      if (j != k) {
+        EXPECT_EQ(b.by_size_seconds[j], a.by_size_seconds[j]);
+      }
+    }
+    EXPECT_DOUBLE_EQ(b.by_size_work[k] - a.by_size_work[k], double(n) * per_entry);
+    const double dt = b.threaded_seconds - a.threaded_seconds;
+    EXPECT_GT(dt, 0);
+    EXPECT_LE(dt, wall + 1e-9);
+    EXPECT_NEAR(b.by_size_seconds[k] - a.by_size_seconds[k], dt, 1e-9);
+    EXPECT_EQ(b.one_thread_seconds, a.one_thread_seconds);
+  }
+  const LaunchCounts a = launch_counts();
+  axpy(8, 0.5, x.data(), y.data());
+  const LaunchCounts b = launch_counts();
+  EXPECT_GT(b.one_thread_seconds, a.one_thread_seconds);
+  EXPECT_EQ(b.threaded_seconds, a.threaded_seconds);
+}
+
+// the profile's rows say how much of their time ran in parallel regions:
+// all of a timed launch, none of a timed serial loop
+TEST(VectorOps, ProfileRowsSayWhatRanThreaded) {
+  const index n = 1 << 21;
+  const auto x = test::random_vector(n, 15);
+  auto y = test::random_vector(n, 16);
+  ASSERT_TRUE(worth_threads(double(n) * kAxpyCost));
+  profile_reset();
+  {
+    const ScopedTimer t(Kernel::vector, double(n) * kAxpyCost);
+    for (int r = 0; r < 5; ++r) axpy(n, 0.5, x.data(), y.data());
+  }
+  {
+    const ScopedTimer t(Kernel::contact_maps);  // serial work only
+    volatile real s = 0;
+    for (index i = 0; i < n; ++i) s = s + y[std::size_t(i)];
+  }
+  const LaunchCounts since = launches_since_reset();
+  EXPECT_EQ(since.threaded, 5);
+  EXPECT_EQ(since.one_thread, 0);
+  double total = 0;
+  for (const ProfileRow& r : profile_rows(1.0)) {
+    if (r.kernel == kernel_name(Kernel::vector)) {
+      EXPECT_GT(r.threaded, 0.9);  // the rest: the timer's own start and end
+      EXPECT_LE(r.threaded, 1.0);
+      total += r.self_seconds;
+    }
+    if (r.kernel == kernel_name(Kernel::contact_maps)) {
+      EXPECT_EQ(r.threaded, 0);
+    }
+  }
+  EXPECT_GT(total, 0);
+  EXPECT_LE(since.threaded_seconds, total);
+  profile_reset();
+  EXPECT_EQ(launches_since_reset().threaded, 0);
 }
 
 TEST(VectorOps, ChebyshevUpdatesFollowTheirFormulas) {

@@ -4,6 +4,7 @@
 
 #include "core/parallel/comm.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/io/cli.hpp"
@@ -108,8 +109,21 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                        {"self_seconds", r.self_seconds},
                        {"share", r.share},
                        {"bytes_per_s", r.bytes_per_s},
-                       {"flops_per_s", r.flops_per_s}});
+                       {"flops_per_s", r.flops_per_s},
+                       {"threaded", r.threaded}});
   j["profile"] = profile;
+  // the launches of the run (kernels/launch.hpp): what ran threaded, what on one thread
+  const LaunchCounts L = launches_since_reset();
+  Json by_size = Json::array();
+  for (int k = 0; k < LaunchCounts::kSizes; ++k)
+    by_size.push_back({{"regions", L.by_size[k]}, {"seconds", L.by_size_seconds[k]}, {"work", L.by_size_work[k]}});
+  j["launches"] = {{"parallel_regions", L.threaded},
+                   {"one_thread", L.one_thread},
+                   {"device", L.device},
+                   {"threaded_seconds", L.threaded_seconds},
+                   {"one_thread_launch_seconds", L.one_thread_seconds},
+                   {"one_thread_seconds", std::max(0.0, R.times.total - L.threaded_seconds)},
+                   {"by_work", by_size}};
   j["times"] = {{"nested", R.times.nested}, {"setup", R.times.setup},   {"condense", R.times.condense},
                 {"solve", R.times.solve},   {"recover", R.times.recover}, {"total", R.times.total}};
   j["counts"] = {{"inner_iterations", R.inner_iterations},
