@@ -38,7 +38,7 @@ bool offload_built() {
 bool launch_on_device() { return on_device; }
 
 std::atomic<long long> detail::launches[3];
-std::atomic<long long> detail::launch_ns[2];
+std::atomic<long long> detail::launch_ns[3];
 namespace {
 constexpr int kSizes = LaunchCounts::kSizes;
 std::atomic<long long> launches_by_size[kSizes], launch_ns_by_size[kSizes];
@@ -63,6 +63,7 @@ LaunchCounts launch_counts() {
   c.device = detail::launches[2].load();
   c.threaded_seconds = 1e-9 * double(detail::launch_ns[0].load());
   c.one_thread_seconds = 1e-9 * double(detail::launch_ns[1].load());
+  c.device_seconds = 1e-9 * double(detail::launch_ns[2].load());
   for (int k = 0; k < kSizes; ++k) {
     c.by_size[k] = launches_by_size[k].load();
     c.by_size_seconds[k] = 1e-9 * double(launch_ns_by_size[k].load());
@@ -343,7 +344,7 @@ void space_zero(Space s, void* p, std::size_t bytes) {
   if (bytes == 0) return;
 #ifdef TRESCA_OFFLOAD
   if (s == Space::device) {
-    detail::counted_device_launch();
+    const detail::DeviceLaunch launch;
     DeviceRegion region;
     unsigned char* q = static_cast<unsigned char*>(p);
 #pragma omp target teams distribute parallel for is_device_ptr(q) device(device())

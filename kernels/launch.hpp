@@ -102,16 +102,18 @@ constexpr int kScratchTeams = 1024;
 // The launches so far, by where they ran: the fork/join census of
 // `--profile` and bench_kernels. A threaded launch is one OpenMP parallel
 // region (a fork, a join and its barrier); a one-thread launch ran on the
-// calling thread, its work below worth_threads. The seconds are wall time
-// on the calling thread from each launch's start to its end: what is not
-// threaded ran on one thread (one-thread launches, and the code between
-// launches), the part that more threads do not shorten. The threaded
+// calling thread, its work below worth_threads; a device launch is one
+// target region. The seconds are wall time on the calling thread from each
+// launch's start to its end (a target region's end waits for the device):
+// what is neither threaded nor on the device ran on one host thread
+// (one-thread launches, and the code between launches), the part that more
+// threads do not shorten. The threaded
 // launches are also counted by their modelled work (bytes + flops), in
 // decades from kParallelWork: where small regions cost more than their
 // work, fork/join and waking the threads is what they pay for.
 struct LaunchCounts {
   long long threaded = 0, one_thread = 0, device = 0;
-  double threaded_seconds = 0, one_thread_seconds = 0;
+  double threaded_seconds = 0, one_thread_seconds = 0, device_seconds = 0;
   static constexpr int kSizes = 3;                     // work below 10x, 100x kParallelWork, and more
   long long by_size[kSizes] = {};
   double by_size_seconds[kSizes] = {}, by_size_work[kSizes] = {};
@@ -119,7 +121,7 @@ struct LaunchCounts {
 LaunchCounts launch_counts();
 namespace detail {
 extern std::atomic<long long> launches[3];  // threaded, one_thread, device
-extern std::atomic<long long> launch_ns[2];  // threaded, one_thread
+extern std::atomic<long long> launch_ns[3];  // threaded, one_thread, device
 inline long long now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();
@@ -148,7 +150,20 @@ class HostLaunch {
   double work_;
   long long t0_;
 };
-inline void counted_device_launch() { launches[2].fetch_add(1, std::memory_order_relaxed); }
+// One device launch (a target region), counted and timed likewise.
+class DeviceLaunch {
+ public:
+  DeviceLaunch() : t0_(now_ns()) {}
+  ~DeviceLaunch() {
+    launches[2].fetch_add(1, std::memory_order_relaxed);
+    launch_ns[2].fetch_add(now_ns() - t0_, std::memory_order_relaxed);
+  }
+  DeviceLaunch(const DeviceLaunch&) = delete;
+  DeviceLaunch& operator=(const DeviceLaunch&) = delete;
+
+ private:
+  long long t0_;
+};
 }  // namespace detail
 
 // How many workers a launch has (threads on the host): a kernel that cuts
@@ -160,7 +175,7 @@ template <class Body>
 inline void for_each_entry(index n, Cost per_entry, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
-    detail::counted_device_launch();
+    const detail::DeviceLaunch launch;
     // a copy of the body, mapped implicitly: its captures (device pointers,
     // scalars) travel by value (GCC 12 fails on a lambda in a map or
     // firstprivate clause: an internal compiler error)
@@ -207,7 +222,7 @@ template <class Body>
 inline void for_each_block(index n, Cost work, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
-    detail::counted_device_launch();
+    const detail::DeviceLaunch launch;
     DeviceRegion region;
     Body b = body;
     const int warps = device_warps();
@@ -224,7 +239,7 @@ template <class Body>
 inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {  // one block per (team) thread; the body's own `omp simd` loops in its lanes
-    detail::counted_device_launch();
+    const detail::DeviceLaunch launch;
     DeviceRegion region;
     Body b = body;
     const int warps = device_warps();
@@ -246,7 +261,7 @@ template <class T, class Body>
 inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost work, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {  // each (team, thread) its slice of one scratch buffer
-    detail::counted_device_launch();
+    const detail::DeviceLaunch launch;
     const int warps = device_warps();
     T* pool = static_cast<T*>(device_scratch(std::size_t(kScratchTeams) * warps * scratch * sizeof(T)));
     DeviceRegion region;
@@ -290,7 +305,7 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
   (void)entry;  // (the host's form is block)
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
-    detail::counted_device_launch();
+    const detail::DeviceLaunch launch;
     DeviceRegion region;
     Entry e = entry;
     const int warps = device_warps();

@@ -245,7 +245,8 @@ int main(int argc, char** argv) {
           j["contact_over_linear"] = R.fine_matvecs_total / fmv_linear;
           summaries.push_back(std::move(j));
           totals.push_back(R.times.total);
-          serial.push_back(std::max(0.0, R.times.total - launches_since_reset().threaded_seconds));
+          const LaunchCounts L = launches_since_reset();
+          serial.push_back(std::max(0.0, R.times.total - L.threaded_seconds - L.device_seconds));
         }
         std::vector<size_t> order(totals.size());
         for (size_t i = 0; i < order.size(); ++i) order[i] = i;

@@ -202,6 +202,31 @@ TEST(Device, VectorKernelsOnTheDeviceMatchTheHost) {
   }
 }
 
+// device launches are counted and timed as such (the profile's "on the
+// device" line), none of them as a host launch
+TEST(Device, LaunchesOnTheDeviceAreCountedAndTimed) {
+  if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
+  const index n = 1 << 20;
+  Field<real> x = on_device(test::random_vector(n, 4)), y = on_device(test::random_vector(n, 5));
+  LaunchCounts a, b;
+  double wall = 0;
+  {
+    OnDevice on;
+    a = launch_counts();
+    const double t0 = omp_get_wtime();
+    axpy(n, 0.5, x.data(), y.data());
+    (void)dot(n, x.data(), y.data());
+    wall = omp_get_wtime() - t0;
+    b = launch_counts();
+  }
+  EXPECT_EQ(b.device - a.device, 2);
+  EXPECT_GT(b.device_seconds, a.device_seconds);
+  EXPECT_LE(b.device_seconds - a.device_seconds, wall + 1e-9);
+  EXPECT_EQ(b.threaded, a.threaded);
+  EXPECT_EQ(b.one_thread, a.one_thread);
+  EXPECT_EQ(b.threaded_seconds, a.threaded_seconds);
+}
+
 // the stencil apply (its row form on the device), stencil and vectors made
 // with the launches on the device, against the banded apply on the host,
 // plain and fused, double and float

@@ -122,12 +122,12 @@ TEST(VectorOps, ProfileRowsSayWhatRanThreaded) {
   double total = 0;
   for (const ProfileRow& r : profile_rows(1.0)) {
     if (r.kernel == kernel_name(Kernel::vector)) {
-      EXPECT_GT(r.threaded, 0.9);  // the rest: the timer's own start and end
-      EXPECT_LE(r.threaded, 1.0);
+      EXPECT_GT(r.parallel, 0.9);  // the rest: the timer's own start and end
+      EXPECT_LE(r.parallel, 1.0);
       total += r.self_seconds;
     }
     if (r.kernel == kernel_name(Kernel::contact_maps)) {
-      EXPECT_EQ(r.threaded, 0);
+      EXPECT_EQ(r.parallel, 0);
     }
   }
   EXPECT_GT(total, 0);

@@ -110,7 +110,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                        {"share", r.share},
                        {"bytes_per_s", r.bytes_per_s},
                        {"flops_per_s", r.flops_per_s},
-                       {"threaded", r.threaded}});
+                       {"parallel", r.parallel}});
   j["profile"] = profile;
   // the launches of the run (kernels/launch.hpp): what ran threaded, what on one thread
   const LaunchCounts L = launches_since_reset();
@@ -122,7 +122,8 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                    {"device", L.device},
                    {"threaded_seconds", L.threaded_seconds},
                    {"one_thread_launch_seconds", L.one_thread_seconds},
-                   {"one_thread_seconds", std::max(0.0, R.times.total - L.threaded_seconds)},
+                   {"device_seconds", L.device_seconds},
+                   {"one_thread_seconds", std::max(0.0, R.times.total - L.threaded_seconds - L.device_seconds)},
                    {"by_work", by_size}};
   j["times"] = {{"nested", R.times.nested}, {"setup", R.times.setup},   {"condense", R.times.condense},
                 {"solve", R.times.solve},   {"recover", R.times.recover}, {"total", R.times.total}};

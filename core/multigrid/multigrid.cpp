@@ -276,8 +276,23 @@ void Multigrid::factor_coarse() {
   cx_.resize(n);
   if (comm().rank() != 0) return;
   SparseMatrix A = assemble(levels_.back().A);
-  coarse_.compute(A);
-  if (coarse_.info() != Eigen::Success) throw std::runtime_error("multigrid: coarse factorisation failed");
+  A.makeCompressed();
+  const index* outer = A.outerIndexPtr();
+  const index* inner = A.innerIndexPtr();
+  const std::size_t cols = std::size_t(A.outerSize()) + 1, nnz = std::size_t(A.nonZeros());
+  const bool same = coarse_outer_.size() == cols && coarse_inner_.size() == nnz &&
+                    std::equal(outer, outer + cols, coarse_outer_.begin()) &&
+                    std::equal(inner, inner + nnz, coarse_inner_.begin());
+  if (!same) {  // the ordering (AMD) and the symbolic factorisation, once per pattern
+    coarse_.analyzePattern(A);
+    coarse_outer_.assign(outer, outer + cols);
+    coarse_inner_.assign(inner, inner + nnz);
+  }
+  coarse_.factorize(A);
+  if (coarse_.info() != Eigen::Success) {
+    coarse_outer_.clear();  // (analysed afresh next time)
+    throw std::runtime_error("multigrid: coarse factorisation failed");
+  }
 }
 
 void Multigrid::set_bottom_block(const std::vector<real>& B) {

@@ -196,6 +196,9 @@ class Multigrid : public LinearOperator {
   std::vector<Work<double>> work_d_;
   std::vector<Work<float>> work_s_;
   Eigen::SimplicialLDLT<SparseMatrix> coarse_;  // on rank 0 (every rank when all levels are whole)
+  // the pattern coarse_ was ordered for (its fill-reducing ordering is kept
+  // while the pattern stays: each bottom block only refactorises)
+  std::vector<index> coarse_outer_, coarse_inner_;
   mutable Eigen::VectorXd cb_, cx_;
 };
 

@@ -15,7 +15,9 @@ namespace tresca {
 namespace {
 ProfileEntry g_entries[int(Kernel::count)];
 LaunchCounts g_launches_at_reset;  // the launch census when the profile was last reset
-double threaded_seconds_so_far() { return launch_counts().threaded_seconds; }
+// the seconds in launches that ran in parallel: host parallel regions and target regions
+double parallel_seconds(const LaunchCounts& c) { return c.threaded_seconds + c.device_seconds; }
+double parallel_seconds_so_far() { return parallel_seconds(launch_counts()); }
 }
 
 const char* kernel_name(Kernel k) {
@@ -56,25 +58,25 @@ ScopedTimer* g_innermost = nullptr;
 }
 
 ScopedTimer::ScopedTimer(Kernel k, Cost cost)
-    : k_(k), b_(cost.bytes), f_(cost.flops), t0_(wall_time()), threaded0_(threaded_seconds_so_far()),
+    : k_(k), b_(cost.bytes), f_(cost.flops), t0_(wall_time()), parallel0_(parallel_seconds_so_far()),
       outer_(g_innermost) {
   g_innermost = this;
 }
 
 ScopedTimer::~ScopedTimer() {
-  const double dt = wall_time() - t0_, threaded = threaded_seconds_so_far() - threaded0_;
+  const double dt = wall_time() - t0_, parallel = parallel_seconds_so_far() - parallel0_;
   g_innermost = outer_;
   if (outer_) {
     outer_->nested_ += dt;
-    outer_->nested_threaded_ += threaded;
+    outer_->nested_parallel_ += parallel;
   }
   // called from the serial driver thread only (kernels parallelise inside)
   ProfileEntry& e = g_entries[int(k_)];
   e.calls += 1;
   e.seconds += dt;
   e.self_seconds += dt - nested_;
-  e.threaded_seconds += threaded;
-  e.self_threaded_seconds += threaded - nested_threaded_;
+  e.parallel_seconds += parallel;
+  e.self_parallel_seconds += parallel - nested_parallel_;
   e.bytes += b_;
   e.flops += f_;
 }
@@ -92,6 +94,7 @@ LaunchCounts launches_since_reset() {
   d.device -= r.device;
   d.threaded_seconds -= r.threaded_seconds;
   d.one_thread_seconds -= r.one_thread_seconds;
+  d.device_seconds -= r.device_seconds;
   for (int k = 0; k < LaunchCounts::kSizes; ++k) {
     d.by_size[k] -= r.by_size[k];
     d.by_size_seconds[k] -= r.by_size_seconds[k];
@@ -102,7 +105,7 @@ LaunchCounts launches_since_reset() {
 
 std::vector<ProfileRow> profile_rows(double total) {
   std::vector<ProfileRow> rows;
-  double counted = 0, counted_threaded = 0;
+  double counted = 0, counted_parallel = 0;
   for (int i = 0; i < int(Kernel::count); ++i) {
     const ProfileEntry& e = g_entries[i];
     if (e.calls == 0) continue;
@@ -112,22 +115,22 @@ std::vector<ProfileRow> profile_rows(double total) {
     r.seconds = e.seconds;
     r.self_seconds = e.self_seconds;
     r.share = total > 0 ? e.self_seconds / total : 0;
-    r.threaded = e.self_seconds > 0 ? std::min(1.0, e.self_threaded_seconds / e.self_seconds) : 0;
+    r.parallel = e.self_seconds > 0 ? std::min(1.0, e.self_parallel_seconds / e.self_seconds) : 0;
     // rows without a traffic model (they contain other rows) show no rates
     if (e.seconds > 0 && e.bytes > 0) {
       r.bytes_per_s = e.bytes / e.seconds;
       r.flops_per_s = e.flops / e.seconds;
     }
     counted += e.self_seconds;
-    counted_threaded += e.self_threaded_seconds;
+    counted_parallel += e.self_parallel_seconds;
     rows.push_back(r);
   }
   ProfileRow other;
   other.kernel = "other";
   other.seconds = other.self_seconds = std::max(0.0, total - counted);
   other.share = total > 0 ? other.self_seconds / total : 0;
-  const double other_threaded = launches_since_reset().threaded_seconds - counted_threaded;
-  other.threaded = other.self_seconds > 0 ? std::clamp(other_threaded / other.self_seconds, 0.0, 1.0) : 0;
+  const double other_parallel = parallel_seconds(launches_since_reset()) - counted_parallel;
+  other.parallel = other.self_seconds > 0 ? std::clamp(other_parallel / other.self_seconds, 0.0, 1.0) : 0;
   rows.push_back(other);
   return rows;
 }
@@ -136,7 +139,7 @@ std::string profile_table(double total) {
   std::string out;
   char line[256];
   std::snprintf(line, sizeof line, "%-22s %10s %10s %10s %7s %9s %9s %8s\n", "kernel", "calls", "time [s]",
-                "self [s]", "share", "GB/s", "GFLOP/s", "threaded");
+                "self [s]", "share", "GB/s", "GFLOP/s", "parallel");
   out += line;
   for (const ProfileRow& r : profile_rows(total)) {
     char gbs[16] = "-", gflops[16] = "-", calls[24] = "-";
@@ -146,40 +149,46 @@ std::string profile_table(double total) {
     }
     if (r.calls > 0) std::snprintf(calls, sizeof calls, "%lld", r.calls);
     std::snprintf(line, sizeof line, "%-22s %10s %10.3f %10.3f %6.1f%% %9s %9s %7.0f%%\n", r.kernel.c_str(), calls,
-                  r.seconds, r.self_seconds, 100 * r.share, gbs, gflops, 100 * r.threaded);
+                  r.seconds, r.self_seconds, 100 * r.share, gbs, gflops, 100 * r.parallel);
     out += line;
   }
   out += "(time: the row's whole time; self: less the rows timed inside it, e.g. the smoother less its\n"
          " applies; share: self / total, so the shares add up to 100 %; other: outside every timer;\n"
-         " threaded: the part of self inside parallel regions, the rest ran on one thread)\n";
+         " parallel: the part of self inside parallel regions (or on the device), the rest ran on one thread)\n";
   // Amdahl's part: what more threads leave as it is
   const LaunchCounts since = launches_since_reset();
   if (total > 0) {
-    const double serial = std::max(0.0, total - since.threaded_seconds);
+    const double serial = std::max(0.0, total - parallel_seconds(since));
     std::snprintf(line, sizeof line,
                   "one thread: %.3f s of the %.3f s (%.1f %%): %.3f s in %lld launches below worth_threads, "
                   "%.3f s between launches; no thread count takes the run below it\n",
                   serial, total, 100 * serial / total, since.one_thread_seconds, since.one_thread,
                   std::max(0.0, serial - since.one_thread_seconds));
     out += line;
+    if (since.device > 0) {
+      std::snprintf(line, sizeof line, "on the device: %.3f s in %lld target regions (each until the device ends it)\n",
+                    since.device_seconds, since.device);
+      out += line;
+    }
   }
   // the parallel regions by size: what the small ones cost each, against their work
-  out += "parallel regions by modelled work (bytes + flops):";
-  for (int k = 0; k < LaunchCounts::kSizes; ++k) {
-    const double lo = kParallelWork * std::pow(10.0, k);
-    const bool last = k + 1 == LaunchCounts::kSizes;
-    char range[48];
-    if (last)
-      std::snprintf(range, sizeof range, ">= %.0e", lo);
-    else
-      std::snprintf(range, sizeof range, "%.0e-%.0e", lo, 10 * lo);
-    const long long n = since.by_size[k];
-    std::snprintf(line, sizeof line, "%s %s: %lld, %.3f s (%.0f us, %.1e each)", k ? ";" : "", range, n,
-                  since.by_size_seconds[k], n ? 1e6 * since.by_size_seconds[k] / double(n) : 0.0,
-                  n ? since.by_size_work[k] / double(n) : 0.0);
-    out += line;
+  if (since.threaded > 0) {
+    out += "parallel regions by modelled work (bytes + flops):";
+    for (int k = 0; k < LaunchCounts::kSizes; ++k) {
+      const double lo = kParallelWork * std::pow(10.0, k);
+      char range[48];
+      if (k + 1 == LaunchCounts::kSizes)
+        std::snprintf(range, sizeof range, ">= %.0e", lo);
+      else
+        std::snprintf(range, sizeof range, "%.0e-%.0e", lo, 10 * lo);
+      const long long n = since.by_size[k];
+      std::snprintf(line, sizeof line, "%s %s: %lld, %.3f s (%.0f us, %.1e each)", k ? ";" : "", range, n,
+                    since.by_size_seconds[k], n ? 1e6 * since.by_size_seconds[k] / double(n) : 0.0,
+                    n ? since.by_size_work[k] / double(n) : 0.0);
+      out += line;
+    }
+    out += "\n";
   }
-  out += "\n";
   // the fork/join census (launch.hpp), and the Fields' block cache
   // (field.hpp), since the program started
   const LaunchCounts n = launch_counts();

@@ -19,7 +19,7 @@ struct ProfileEntry {
   long long calls = 0;
   double seconds = 0, bytes = 0, flops = 0;
   double self_seconds = 0;  // less the time of the timers nested in it (smoother: less its applies)
-  double threaded_seconds = 0, self_threaded_seconds = 0;  // of those, inside parallel regions
+  double parallel_seconds = 0, self_parallel_seconds = 0;  // of those, inside parallel or target regions
 };
 
 // One row of the profile. Timers nest (an inner CG contains applies, the
@@ -27,20 +27,20 @@ struct ProfileEntry {
 // the part no nested row counts, and `share` = self / total, so the shares
 // of the rows and of "other" (outside every timer: setup, Newton's own
 // bookkeeping, output) add up to 100 %. Rates use the whole time and are 0
-// where a row has no traffic model. `threaded` is the share of the row's
-// self time spent inside parallel regions (launch.hpp): the rest ran on
-// one thread, and more threads do not shorten it.
+// where a row has no traffic model. `parallel` is the share of the row's
+// self time spent inside parallel regions or on the device (launch.hpp):
+// the rest ran on one host thread, and more threads do not shorten it.
 struct ProfileRow {
   std::string kernel;
   long long calls = 0;
-  double seconds = 0, self_seconds = 0, share = 0, bytes_per_s = 0, flops_per_s = 0, threaded = 0;
+  double seconds = 0, self_seconds = 0, share = 0, bytes_per_s = 0, flops_per_s = 0, parallel = 0;
 };
 std::vector<ProfileRow> profile_rows(double total_seconds);
 // forget what was timed so far (a driver running several solves: before each)
 void profile_reset();
 // the launch census (kernels/launch.hpp) since the last profile_reset (since
-// the start, if none): how many launches, and their seconds threaded and
-// on one thread
+// the start, if none): how many launches, and their seconds threaded, on
+// one thread and on the device
 struct LaunchCounts;
 LaunchCounts launches_since_reset();
 // the rows as a table: calls, time, self time, share, GB/s and GFLOP/s
@@ -81,8 +81,8 @@ class ScopedTimer {
 
  private:
   Kernel k_;
-  double b_, f_, t0_, threaded0_;
-  double nested_ = 0, nested_threaded_ = 0;  // the time (and threaded time) of the timers ended inside this one
+  double b_, f_, t0_, parallel0_;
+  double nested_ = 0, nested_parallel_ = 0;  // the time (and parallel time) of the timers ended inside this one
   ScopedTimer* outer_;
 };
 
