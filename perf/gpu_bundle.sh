@@ -35,6 +35,8 @@ cat > "$out/run.sh" <<'RUN'
 #                   Device.PresentWhereRequired; GCC 12 falls back to the
 #                   host even with OMP_TARGET_OFFLOAD=MANDATORY)
 #   run.sh bench    the Device* benchmarks and roofline --device gpu at level 13
+#                   (DeviceAxpy/1024 and DeviceDot/1024: what one launch costs;
+#                   contact's --profile says how many launches a solve makes)
 #   run.sh elastic  the MG-CG solve, GPU then CPU, levels 10, 12, 13
 #   run.sh contact  tresca, GPU then CPU, levels 8 and 12 and Coulomb 0.8 at
 #                   level 10: the contact values' largest difference relative
