@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -46,8 +45,8 @@ std::atomic<double> work_by_size[kSizes];
 }  // namespace
 
 void detail::count_threaded_launch(double work, long long ns) {
-  int k = 0;
-  while (k + 1 < kSizes && work >= kParallelWork * std::pow(10.0, k + 1)) ++k;
+  const int k = work < 10 * kParallelWork ? 0 : work < 100 * kParallelWork ? 1 : 2;
+  static_assert(kSizes == 3, "the size classes above");
   launches[0].fetch_add(1, std::memory_order_relaxed);
   launch_ns[0].fetch_add(ns, std::memory_order_relaxed);
   launches_by_size[k].fetch_add(1, std::memory_order_relaxed);

@@ -107,14 +107,14 @@ constexpr int kScratchTeams = 1024;
 // launch's start to its end (a target region's end waits for the device):
 // what is neither threaded nor on the device ran on one host thread
 // (one-thread launches, and the code between launches), the part that more
-// threads do not shorten. The threaded
-// launches are also counted by their modelled work (bytes + flops), in
-// decades from kParallelWork: where small regions cost more than their
-// work, fork/join and waking the threads is what they pay for.
+// threads do not shorten. The threaded launches are also counted by their
+// modelled work (bytes + flops), in decades from kParallelWork: where small
+// regions cost more than their work, fork/join and waking the threads is
+// what they pay for.
 struct LaunchCounts {
   long long threaded = 0, one_thread = 0, device = 0;
   double threaded_seconds = 0, one_thread_seconds = 0, device_seconds = 0;
-  static constexpr int kSizes = 3;                     // work below 10x, 100x kParallelWork, and more
+  static constexpr int kSizes = 3;  // work below 10x, 100x kParallelWork, and more
   long long by_size[kSizes] = {};
   double by_size_seconds[kSizes] = {}, by_size_work[kSizes] = {};
 };
