@@ -47,6 +47,21 @@ struct AxisView {
       : j0(a.j0.data()), tstart(a.tstart.data()), tf(a.tf.data()), w(a.w.data()), tw(a.tw.data()) {}
 };
 
+// Which entries of the output row (iy, iz) of grid g lie on a face in
+// `faces` (zero_constrained's rule, node_constrained's faces): the whole
+// row on a y or z face, else its ends on x faces. Zero is written there in
+// the row's own loop, as a select per entry: no second launch, and on the
+// device no lane writes an entry another lane writes.
+struct RowMask {
+  bool whole, x0, x1;
+  index last;
+  RowMask(const GridDims& g, unsigned faces, index iy, index iz)
+      : whole(((faces & kFaceY0) && iy == 0) || ((faces & kFaceY1) && iy == g.ey) ||
+              ((faces & kFaceZ0) && iz == 0) || ((faces & kFaceZ1) && iz == g.ez)),
+        x0(faces & kFaceX0), x1(faces & kFaceX1), last(g.ex) {}
+  bool zero(index ix) const { return whole || (x0 && ix == 0) || (x1 && ix == last); }
+};
+
 }  // namespace
 
 Transfer build_transfer(const GridDims& fine, const GridDims& coarse) {
@@ -91,7 +106,7 @@ Transfer slice_rows(const Transfer& whole, index f0, index f1, index c0, index c
 }
 
 template <class T>
-void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool accumulate) {
+void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool accumulate, unsigned zero_faces) {
   TRESCA_ASSERT(comps >= 1 && comps <= 3 && index(t.axis[0].j0.size()) == t.fine.nx());
   // Per fine row (iy, iz): combine the 4 coarse rows of its y/z support into
   // one coarse-length row buffer (contiguous, vectorised), then interpolate
@@ -103,6 +118,7 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
   const AxisView X(t.axis[0]), Y(t.axis[1]), Z(t.axis[2]);
   // one fine row (iy, iz); s: a coarse row of the worker's own
   const auto fine_row = [=](index iz, index iy, T* s) {
+    const RowMask m(f, zero_faces, iy, iz);
     const index jz = Z.j0[iz], jy = Y.j0[iy];
     const T wz = T(Z.w[iz]), wy = T(Y.w[iy]);
     const T w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
@@ -116,7 +132,8 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
       for (index ix = 0; ix < fnx; ++ix) {
         const index j = X.j0[ix];
         const T wx = T(X.w[ix]);
-        v[ix] = (accumulate ? v[ix] : T(0)) + (1 - wx) * s[j] + wx * s[j + 1];
+        const T p = (accumulate ? v[ix] : T(0)) + (1 - wx) * s[j] + wx * s[j + 1];
+        v[ix] = m.zero(ix) ? T(0) : p;
       }
     }
   };
@@ -124,8 +141,8 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
                                  fine_row);
 }
 
-template void prolongate<double>(const Transfer&, int, const double*, double*, bool);
-template void prolongate<float>(const Transfer&, int, const float*, float*, bool);
+template void prolongate<double>(const Transfer&, int, const double*, double*, bool, unsigned);
+template void prolongate<float>(const Transfer&, int, const float*, float*, bool, unsigned);
 
 void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate) {
   const GridDims &f = t.fine, &c = t.coarse;
@@ -148,7 +165,7 @@ void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine
 }
 
 template <class T>
-void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) {
+void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse, unsigned zero_faces) {
   TRESCA_ASSERT(comps >= 1 && comps <= 3 && index(t.axis[0].tstart.size()) == t.coarse.nx() + 1);
   // Per coarse row (jy, jz): sum the weighted fine rows of its y/z support
   // into one row buffer (contiguous, vectorisable), then gather along x.
@@ -158,6 +175,7 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) 
   const AxisView X(t.axis[0]), Y(t.axis[1]), Z(t.axis[2]);
   // one coarse row (jy, jz); acc: a fine row of the worker's own
   const auto coarse_row = [=](index jz, index jy, T* acc) {
+    const RowMask m(c, zero_faces, jy, jz);
     for (int a = 0; a < comps; ++a) {
 #pragma omp simd
       for (index i = 0; i < fnx; ++i) acc[i] = 0;
@@ -173,7 +191,7 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) 
       for (index jx = 0; jx < cnx; ++jx) {
         T sx = 0;
         for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += T(X.tw[kx]) * acc[X.tf[kx]];
-        out[jx] = sx;
+        out[jx] = m.zero(jx) ? T(0) : sx;
       }
     }
   };
@@ -181,8 +199,8 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse) 
                                  coarse_row);
 }
 
-template void restrict_to_coarse<double>(const Transfer&, int, const double*, double*);
-template void restrict_to_coarse<float>(const Transfer&, int, const float*, float*);
+template void restrict_to_coarse<double>(const Transfer&, int, const double*, double*, unsigned);
+template void restrict_to_coarse<float>(const Transfer&, int, const float*, float*, unsigned);
 
 void restrict_to_coarse_ref(const Transfer& t, int comps, const real* fine, real* coarse) {
   const GridDims &f = t.fine, &c = t.coarse;

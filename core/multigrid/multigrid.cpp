@@ -350,8 +350,8 @@ void Multigrid::restrict_residual(int l) const {
     fine = w.fine_rows.data();
   }
   if (grids_->agglomerated(l + 1) && comm().rank() != 0) return;
-  restrict_to_coarse<T>(k.restrict_t, 3, fine, cw.b.data());
-  zero_constrained<T>(C.grid(), C.faces(), cw.b.data());
+  TRESCA_ASSERT(k.restrict_t.coarse.nodes() == C.grid().nodes() && k.restrict_t.coarse.ey == C.grid().ey);
+  restrict_to_coarse<T>(k.restrict_t, 3, fine, cw.b.data(), C.faces());  // zero on C's constrained faces
   C.zero_ghosts(cw.b.data());
 }
 
@@ -370,8 +370,8 @@ void Multigrid::prolongate_correction(int l) const {
     k.fetch_coarse->fetch<T>(cw.x.data(), w.coarse_rows.data());
     coarse = w.coarse_rows.data();
   }
-  prolongate<T>(k.prolong_t, 3, coarse, w.xp, true);
-  zero_constrained<T>(A.grid(), A.faces(), w.xp);
+  TRESCA_ASSERT(k.prolong_t.fine.nodes() == A.grid().nodes() && k.prolong_t.fine.ey == A.grid().ey);
+  prolongate<T>(k.prolong_t, 3, coarse, w.xp, true, A.faces());  // and zero on A's constrained faces
 }
 
 template <class T>
