@@ -315,19 +315,17 @@ void zero_constrained(const GridDims& g, unsigned faces, T* v) {
   // constrained x faces (O(surface) work, one launch)
   const index nx = g.nx(), ny = g.ny(), nz = g.nz(), N = g.nodes();
   if (!faces) return;
-  const bool x0 = faces & kFaceX0, x1 = faces & kFaceX1;
-  const bool y0 = faces & kFaceY0, y1 = faces & kFaceY1, z0 = faces & kFaceZ0, z1 = faces & kFaceZ1;
   for_each_block(nz, ny, double(ny) * double(nz) * Cost{48, 0}, [=](index iz, index iy) {
-    const bool whole = (y0 && iy == 0) || (y1 && iy == ny - 1) || (z0 && iz == 0) || (z1 && iz == nz - 1);
+    const ConstrainedRow c(g, faces, iy, iz);
     for (int a = 0; a < 3; ++a) {
       T* row = v + a * N + nx * (iy + ny * iz);
-      if (whole) {
+      if (c.whole) {
 #pragma omp simd
         for (index ix = 0; ix < nx; ++ix) row[ix] = 0;
         continue;
       }
-      if (x0) row[0] = 0;
-      if (x1) row[nx - 1] = 0;
+      if (c.x0) row[0] = 0;
+      if (c.x1) row[nx - 1] = 0;
     }
   });
 }

@@ -39,6 +39,19 @@ inline GridDims rows_box(const GridDims& g, index a, index b) {
   return r;
 }
 
+// Which nodes of the node row (iy, iz) of g lie on a face in `faces`: the
+// whole row where it lies on a y or z face, else its ends on x faces
+// (node_constrained below, a row at a time).
+struct ConstrainedRow {
+  bool whole, x0, x1;
+  index last;  // the row's last node, ex
+  ConstrainedRow(const GridDims& g, unsigned faces, index iy, index iz)
+      : whole(((faces & kFaceY0) && iy == 0) || ((faces & kFaceY1) && iy == g.ey) ||
+              ((faces & kFaceZ0) && iz == 0) || ((faces & kFaceZ1) && iz == g.ez)),
+        x0(faces & kFaceX0), x1(faces & kFaceX1), last(g.ex) {}
+  bool at(index ix) const { return whole || (x0 && ix == 0) || (x1 && ix == last); }
+};
+
 // Is node (ix,iy,iz) on a constrained face?
 inline bool node_constrained(const GridDims& g, unsigned faces, index ix, index iy, index iz) {
   return ((faces & kFaceX0) && ix == 0) || ((faces & kFaceX1) && ix == g.ex) ||

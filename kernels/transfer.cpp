@@ -47,21 +47,6 @@ struct AxisView {
       : j0(a.j0.data()), tstart(a.tstart.data()), tf(a.tf.data()), w(a.w.data()), tw(a.tw.data()) {}
 };
 
-// Which entries of the output row (iy, iz) of grid g lie on a face in
-// `faces` (zero_constrained's rule, node_constrained's faces): the whole
-// row on a y or z face, else its ends on x faces. Zero is written there in
-// the row's own loop, as a select per entry: no second launch, and on the
-// device no lane writes an entry another lane writes.
-struct RowMask {
-  bool whole, x0, x1;
-  index last;
-  RowMask(const GridDims& g, unsigned faces, index iy, index iz)
-      : whole(((faces & kFaceY0) && iy == 0) || ((faces & kFaceY1) && iy == g.ey) ||
-              ((faces & kFaceZ0) && iz == 0) || ((faces & kFaceZ1) && iz == g.ez)),
-        x0(faces & kFaceX0), x1(faces & kFaceX1), last(g.ex) {}
-  bool zero(index ix) const { return whole || (x0 && ix == 0) || (x1 && ix == last); }
-};
-
 }  // namespace
 
 Transfer build_transfer(const GridDims& fine, const GridDims& coarse) {
@@ -118,7 +103,9 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
   const AxisView X(t.axis[0]), Y(t.axis[1]), Z(t.axis[2]);
   // one fine row (iy, iz); s: a coarse row of the worker's own
   const auto fine_row = [=](index iz, index iy, T* s) {
-    const RowMask m(f, zero_faces, iy, iz);
+    // 0 on the faces in zero_faces, as a select per entry: on the device no
+    // lane writes another lane's entry
+    const ConstrainedRow m(f, zero_faces, iy, iz);
     const index jz = Z.j0[iz], jy = Y.j0[iy];
     const T wz = T(Z.w[iz]), wy = T(Y.w[iy]);
     const T w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
@@ -133,7 +120,7 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
         const index j = X.j0[ix];
         const T wx = T(X.w[ix]);
         const T p = (accumulate ? v[ix] : T(0)) + (1 - wx) * s[j] + wx * s[j + 1];
-        v[ix] = m.zero(ix) ? T(0) : p;
+        v[ix] = m.at(ix) ? T(0) : p;
       }
     }
   };
@@ -175,7 +162,7 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse, 
   const AxisView X(t.axis[0]), Y(t.axis[1]), Z(t.axis[2]);
   // one coarse row (jy, jz); acc: a fine row of the worker's own
   const auto coarse_row = [=](index jz, index jy, T* acc) {
-    const RowMask m(c, zero_faces, jy, jz);
+    const ConstrainedRow m(c, zero_faces, jy, jz);
     for (int a = 0; a < comps; ++a) {
 #pragma omp simd
       for (index i = 0; i < fnx; ++i) acc[i] = 0;
@@ -191,7 +178,7 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse, 
       for (index jx = 0; jx < cnx; ++jx) {
         T sx = 0;
         for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += T(X.tw[kx]) * acc[X.tf[kx]];
-        out[jx] = m.zero(jx) ? T(0) : sx;
+        out[jx] = m.at(jx) ? T(0) : sx;
       }
     }
   };

@@ -26,7 +26,6 @@
 #include "core/util/profile.hpp"
 #include "core/contact/run.hpp"
 #include "kernels/isa.hpp"
-#include "kernels/launch.hpp"
 
 using namespace tresca;
 
@@ -245,8 +244,7 @@ int main(int argc, char** argv) {
           j["contact_over_linear"] = R.fine_matvecs_total / fmv_linear;
           summaries.push_back(std::move(j));
           totals.push_back(R.times.total);
-          const LaunchCounts L = launches_since_reset();
-          serial.push_back(std::max(0.0, R.times.total - L.threaded_seconds - L.device_seconds));
+          serial.push_back(one_thread_seconds(R.times.total));
         }
         std::vector<size_t> order(totals.size());
         for (size_t i = 0; i < order.size(); ++i) order[i] = i;

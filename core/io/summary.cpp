@@ -4,7 +4,6 @@
 
 #include "core/parallel/comm.hpp"
 
-#include <algorithm>
 #include <cmath>
 
 #include "core/io/cli.hpp"
@@ -123,7 +122,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                    {"threaded_seconds", L.threaded_seconds},
                    {"one_thread_launch_seconds", L.one_thread_seconds},
                    {"device_seconds", L.device_seconds},
-                   {"one_thread_seconds", std::max(0.0, R.times.total - L.threaded_seconds - L.device_seconds)},
+                   {"one_thread_seconds", one_thread_seconds(R.times.total)},
                    {"by_work", by_size}};
   j["times"] = {{"nested", R.times.nested}, {"setup", R.times.setup},   {"condense", R.times.condense},
                 {"solve", R.times.solve},   {"recover", R.times.recover}, {"total", R.times.total}};

@@ -103,6 +103,8 @@ LaunchCounts launches_since_reset() {
   return d;
 }
 
+double one_thread_seconds(double total) { return std::max(0.0, total - parallel_seconds(launches_since_reset())); }
+
 std::vector<ProfileRow> profile_rows(double total) {
   std::vector<ProfileRow> rows;
   double counted = 0, counted_parallel = 0;
@@ -158,7 +160,7 @@ std::string profile_table(double total) {
   // Amdahl's part: what more threads leave as it is
   const LaunchCounts since = launches_since_reset();
   if (total > 0) {
-    const double serial = std::max(0.0, total - parallel_seconds(since));
+    const double serial = one_thread_seconds(total);
     std::snprintf(line, sizeof line,
                   "one thread: %.3f s of the %.3f s (%.1f %%): %.3f s in %lld launches below worth_threads, "
                   "%.3f s between launches; no thread count takes the run below it\n",

@@ -43,6 +43,9 @@ void profile_reset();
 // one thread and on the device
 struct LaunchCounts;
 LaunchCounts launches_since_reset();
+// of a run of `total` seconds since the last profile_reset, the part outside
+// every parallel region and target region: what ran on one host thread
+double one_thread_seconds(double total);
 // the rows as a table: calls, time, self time, share, GB/s and GFLOP/s
 std::string profile_table(double total_seconds);
 
