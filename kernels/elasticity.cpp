@@ -157,20 +157,17 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, const ApplyOut
   TRESCA_ASSERT(x != out.y && (out.b == nullptr || out.b != out.y));
   TRESCA_ASSERT(!k.groups.empty());
   if (launch_on_device()) return elasticity_apply_rows(view(k), x, out, rows);  // the device's form
-  // Cache blocking: each thread sweeps z over a band of about kBand x-rows, so
-  // the three input planes of the band (3 x (kBand+2) rows) stay in L2.
+  // Each thread its share of the rows (the nodes it owns in every kernel,
+  // launch.hpp), swept in bands of about kBand x-rows through its planes, so
+  // that the three input planes of a band (3 x (kBand+2) rows) stay in L2.
   constexpr index kBand = 16;
-  const index rows_y = rows.y_end - rows.y_begin;
-  const index width = launch_width();
-  const index nbands = std::max<index>(1, width * ((rows_y + width * kBand - 1) / (width * kBand)));
-  const index band = (rows_y + nbands - 1) / nbands;
-  const double nodes = double(nx) * double(rows_y) * double(rows.z_end - rows.z_begin);
+  const index rows_y = rows.y_end - rows.y_begin, rows_z = rows.z_end - rows.z_begin;
+  const double nodes = double(nx) * double(rows_y) * double(rows_z);
   const StencilView<T> v = view(k);
   // each band's arithmetic in the instruction set chosen at start (isa.hpp)
   const auto apply_band = isa_apply_band<T>(isa());
-  for_each_host_block(nbands, nodes * in_precision<T>(apply_cost(out)), [=](index bnd) {
-    const index y0 = rows.y_begin + bnd * band, y1 = std::min(rows.y_end, y0 + band);
-    if (y0 < y1) apply_band(v, x, out, RowBlock{rows.z_begin, rows.z_end, y0, y1});
+  for_each_host_share(rows_y * rows_z, nodes * in_precision<T>(apply_cost(out)), [=](Share s) {
+    for_each_row_band(rows, s, kBand, [&](const RowBlock& b) { apply_band(v, x, out, b); });
   });
 }
 template void elasticity_apply<double>(const ElasticityStencilT<double>&, const double*, const ApplyOut<double>&,

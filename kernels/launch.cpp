@@ -310,17 +310,17 @@ void space_free(Space s, void* p, std::size_t bytes) noexcept {
 BlockReuse block_reuse(Space s) { return block_cache(s).stats(); }
 
 namespace {
-// piece(begin, size) over [0, bytes), each host worker its contiguous share
-// (the share schedule(static) gives it in the kernels that sweep the entries
-// later): a fresh block's first touch, and its page faults, on every thread
-// instead of one. Small ranges stay on the calling thread (worth_threads).
+// piece(begin, size) over [0, bytes), each host worker its shares of the
+// entries (entry_share over the bytes: of a 3D vector, the nodes it sweeps
+// in every kernel later): a fresh block's first touch, and its page faults,
+// on every thread instead of one, and each page on the thread (and the
+// NUMA node) that will use it. Small ranges stay on the calling thread.
 template <class Piece>
 void by_host_shares(std::size_t bytes, const Piece& piece) {
-  const index w = launch_width();
-  for_each_host_block(w, Cost{double(bytes), 0}, [&](index t) {
-    const std::size_t b0 = bytes / std::size_t(w) * std::size_t(t) + std::min(bytes % std::size_t(w), std::size_t(t));
-    const std::size_t b1 = b0 + bytes / std::size_t(w) + (std::size_t(t) < bytes % std::size_t(w) ? 1 : 0);
-    piece(b0, b1 - b0);
+  const detail::HostLaunch launch(Cost{double(bytes), 0});
+  detail::on_host_workers(launch.threads, [&](index t, index w) {
+    detail::for_entry_runs(index(bytes), t, w,
+                           [&](index b0, index b1) { piece(std::size_t(b0), std::size_t(b1 - b0)); });
   });
 }
 }  // namespace

@@ -6,8 +6,9 @@
 // the backends (in the spirit of a `parallel_for` over an index range):
 //
 //   - host (this file): OpenMP threads when the modelled work is worth it
-//     (worth_threads, types.hpp), schedule(static) so every sweep gives each
-//     thread the same entries, and so the pages it touched first;
+//     (worth_threads, types.hpp), each thread its share of the nodes by one
+//     partition for every kernel (below: host_share), so every sweep gives
+//     a thread the nodes whose pages it touched first;
 //   - the `_ref` twins are plain serial loops beside each kernel (the
 //     independent oracle of the tests, not a backend);
 //   - the device (a TRESCA_OFFLOAD build, below): a second branch inside
@@ -166,9 +167,52 @@ class DeviceLaunch {
 };
 }  // namespace detail
 
-// How many workers a launch has (threads on the host): a kernel that cuts
-// its range into cache-sized blocks makes at least one block per worker.
-inline index launch_width() { return omp_get_max_threads(); }
+// The host's one partition of a launch among its w workers: worker t owns
+// the same nodes in every kernel, and so the memory it touched first (a
+// fresh Field's pages are touched by the same rule, launch.cpp), which on a
+// server with several NUMA nodes is memory on its own socket. Every 3D
+// vector is three components of N nodes, component-major (grid.hpp), and a
+// grid's node rows (iy, iz) hold its nodes in order, so:
+//   - a range of n entries (or of blocks of them), a launch over one index,
+//     is cut into thirds, and worker t takes the t-th w-th of each third
+//     (entry_share): of a vector, its nodes' entries in every component;
+//   - a range of node rows, a launch over (iz, iy), is taken in order, and
+//     worker t takes the t-th w-th of the rows (host_share): the same nodes,
+//     up to one row at each end.
+// Shares differ by at most one entry or row (no idle worker, whatever n).
+struct Share {
+  index begin, end;
+};
+inline Share host_share(index n, index t, index w) { return {n * t / w, n * (t + 1) / w}; }
+constexpr index kThirds = 3;
+inline Share entry_share(index n, index third, index t, index w) {
+  const index a = n * third / kThirds, b = n * (third + 1) / kThirds;
+  const Share s = host_share(b - a, t, w);
+  return {a + s.begin, a + s.end};
+}
+
+namespace detail {
+// body(t, w) on each of the w workers of a host launch (one unless threads)
+template <class Body>
+inline void on_host_workers(bool threads, const Body& body) {
+#pragma omp parallel if (threads)
+  body(index(omp_get_thread_num()), index(omp_get_num_threads()));
+}
+// body(i0, i1) for each nonempty run of worker t's entries of [0, n)
+template <class Body>
+inline void for_entry_runs(index n, index t, index w, const Body& body) {
+  for (index c = 0; c < kThirds; ++c) {
+    const Share s = entry_share(n, c, t, w);
+    if (s.begin < s.end) body(s.begin, s.end);
+  }
+}
+// body(j, i) for worker t's node rows of an n1 x n0 range (j slow, i fast)
+template <class Body>
+inline void for_row_share(index n1, index n0, index t, index w, const Body& body) {
+  const Share s = host_share(n1 * n0, t, w);
+  for (index k = s.begin; k < s.end; ++k) body(k / n0, k % n0);
+}
+}  // namespace detail
 
 // body(i) for every i in [0, n), independent entries vectorised across i.
 template <class Body>
@@ -188,8 +232,12 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
   }
 #endif
   const detail::HostLaunch launch(double(n) * per_entry);
-#pragma omp parallel for simd schedule(static) if (parallel : launch.threads)
-  for (index i = 0; i < n; ++i) body(i);
+  detail::on_host_workers(launch.threads, [&](index t, index w) {
+    detail::for_entry_runs(n, t, w, [&](index i0, index i1) {
+#pragma omp simd
+      for (index i = i0; i < i1; ++i) body(i);
+    });
+  });
 }
 
 // Before a loop inside a block's body whose iterations a GPU warp's lanes
@@ -211,8 +259,20 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
 template <class Body>
 inline void for_each_host_block(index n, Cost work, const Body& body) {
   const detail::HostLaunch launch(work);
-#pragma omp parallel for schedule(static) if (launch.threads)
-  for (index b = 0; b < n; ++b) body(b);
+  detail::on_host_workers(launch.threads, [&](index t, index w) {
+    detail::for_entry_runs(n, t, w, [&](index b0, index b1) {
+      for (index b = b0; b < b1; ++b) body(b);
+    });
+  });
+}
+
+// body(s) once on each host worker, s its share of n node rows (host_share),
+// for a kernel that sweeps its rows in an order of its own (the banded
+// apply's cache bands, kernels/elasticity.cpp). Host only, like the above.
+template <class Body>
+inline void for_each_host_share(index n, Cost work, const Body& body) {
+  const detail::HostLaunch launch(work);
+  detail::on_host_workers(launch.threads, [&](index t, index w) { body(host_share(n, t, w)); });
 }
 
 // body(b) for every block b in [0, n): independent blocks of work (rows,
@@ -250,9 +310,8 @@ inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
   }
 #endif
   const detail::HostLaunch launch(work);
-#pragma omp parallel for collapse(2) schedule(static) if (launch.threads)
-  for (index j = 0; j < n1; ++j)
-    for (index i = 0; i < n0; ++i) body(j, i);
+  detail::on_host_workers(launch.threads,
+                          [&](index t, index w) { detail::for_row_share(n1, n0, t, w, body); });
 }
 
 // The same, with `scratch` entries of T private to each worker for the
@@ -274,14 +333,11 @@ inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost 
   }
 #endif
   const detail::HostLaunch launch(work);
-#pragma omp parallel if (launch.threads)
-  {
+  detail::on_host_workers(launch.threads, [&](index t, index w) {
     std::vector<T> buffer(scratch);
     T* s = buffer.data();
-#pragma omp for collapse(2) schedule(static)
-    for (index j = 0; j < n1; ++j)
-      for (index i = 0; i < n0; ++i) body(j, i, s);
-  }
+    detail::for_row_share(n1, n0, t, w, [&](index j, index i) { body(j, i, s); });
+  });
 }
 
 // Sum of block(i0, i1) over the fixed blocks [b*width, (b+1)*width) of
@@ -320,9 +376,14 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
   } else
 #endif
   {
+    // each block on the worker that owns its first entry
     const detail::HostLaunch launch(double(n) * per_entry);
-#pragma omp parallel for schedule(static) if (launch.threads)
-    for (index b = 0; b < nb; ++b) part[b] = block(b * width, std::min(n, (b + 1) * width));
+    detail::on_host_workers(launch.threads, [&](index t, index w) {
+      detail::for_entry_runs(n, t, w, [&](index i0, index i1) {
+        for (index b = (i0 + width - 1) / width; b * width < i1; ++b)
+          part[b] = block(b * width, std::min(n, (b + 1) * width));
+      });
+    });
   }
   real s = 0;
   for (index b = 0; b < nb; ++b) s += part[b];

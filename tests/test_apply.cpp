@@ -1,6 +1,7 @@
 // The matrix-free elasticity apply against an assembled sparse K, its _ref
 // twin, symmetry, the rigid-body kernel and the patch test.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/SparseCore>
 #include <cmath>
@@ -108,6 +109,55 @@ TEST(ElasticityApply, RowFormEqualsTheBandedApply) {
         EXPECT_LE(d, 1e-5f * m) << "float";
       }
   });
+}
+
+// The banded apply's sweep of one worker's rows (for_each_row_band): every
+// row of the share once, in blocks of at most one band of rows or of one
+// plane, for shares that start and end inside planes, span one, or many.
+TEST(ElasticityApply, RowBandsCoverAWorkersRowsOnce) {
+  const RowBlock blocks[] = {{0, 9, 0, 37}, {2, 7, 5, 18}, {0, 1, 0, 3}};
+  for (const RowBlock& rows : blocks) {
+    const index ny = rows.y_end - rows.y_begin, R = ny * (rows.z_end - rows.z_begin);
+    for (index w : {1, 2, 3, 5, 16, 64})
+      for (index t = 0; t < w; ++t) {
+        const Share s = host_share(R, t, w);
+        std::vector<int> seen(std::size_t(R), 0);
+        for_each_row_band(rows, s, 16, [&](const RowBlock& b) {
+          EXPECT_TRUE(b.z_end - b.z_begin == 1 || b.y_end - b.y_begin <= 16);
+          for (index z = b.z_begin; z < b.z_end; ++z)
+            for (index y = b.y_begin; y < b.y_end; ++y) {
+              ASSERT_TRUE(rows.z_begin <= z && z < rows.z_end && rows.y_begin <= y && y < rows.y_end);
+              ++seen[std::size_t((z - rows.z_begin) * ny + (y - rows.y_begin))];
+            }
+        });
+        for (index r = 0; r < R; ++r)
+          EXPECT_EQ(seen[std::size_t(r)], s.begin <= r && r < s.end ? 1 : 0) << "row " << r << ", worker " << t << " of " << w;
+      }
+  }
+}
+
+// The apply on any number of threads, each with its share of the rows
+// (shares that cut planes anywhere): the same answer bit for bit, each
+// entry being the same sum whoever computes it.
+TEST(ElasticityApply, EveryThreadCountGivesTheSameAnswerBitForBit) {
+  const GridDims g = test::prism(23, 12, 10);
+  const ElasticityStencil k = build_elasticity_stencil(g, kFaceX0 | kFaceZ0, 1.0, 0.3);
+  ASSERT_TRUE(worth_threads(double(g.nodes()) * apply_cost(operator_out<real>(nullptr))));
+  const auto x = random_vector(k.size(), 41), b = random_vector(k.size(), 42);
+  const int threads = omp_get_max_threads();
+  std::vector<real> y1(k.size()), r1(k.size());
+  omp_set_num_threads(1);
+  elasticity_apply(k, x.data(), y1.data(), RowBlock{0, g.nz(), 0, g.ny()});
+  elasticity_apply(k, x.data(), r1.data(), RowBlock{0, g.nz(), 0, g.ny()}, b.data());
+  for (int w : {2, 3, 5, 8}) {
+    omp_set_num_threads(w);
+    std::vector<real> y(k.size(), 7.0), r(k.size(), 7.0);
+    elasticity_apply(k, x.data(), y.data(), RowBlock{0, g.nz(), 0, g.ny()});
+    elasticity_apply(k, x.data(), r.data(), RowBlock{0, g.nz(), 0, g.ny()}, b.data());
+    EXPECT_EQ(y, y1) << w << " threads";
+    EXPECT_EQ(r, r1) << w << " threads";
+  }
+  omp_set_num_threads(threads);
 }
 
 // The smoother's Chebyshev step fused into the apply (kernels/apply_out.hpp)

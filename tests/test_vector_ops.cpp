@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "core/fem/problem.hpp"
 #include "core/util/profile.hpp"
 #include "kernels/launch.hpp"
 #include "kernels/vector_ops.hpp"
@@ -42,6 +43,69 @@ TEST(VectorOps, ReductionsAreBitwiseIndependentOfThreadCount) {
   const real d2 = dot(n, x.data(), y.data());
   omp_set_num_threads(threads);
   EXPECT_EQ(d1, d2);
+}
+
+// The host's one partition (launch.hpp): every entry on one worker, shares
+// within one entry of each other, and a worker's entries the same nodes in
+// each of a vector's three components, whatever n and the worker count.
+TEST(Partition, EntrySharesCoverEachEntryOnceAndKeepAWorkerOnItsNodes) {
+  for (index n : {index(0), index(1), index(2), index(7), index(3 * 1000), index(3 * 4097), index(100003)})
+    for (index w : {1, 2, 3, 5, 16, 128}) {
+      std::vector<int> seen(std::size_t(n), 0);
+      for (index c = 0; c < kThirds; ++c) {
+        index smallest = n, largest = 0;
+        for (index t = 0; t < w; ++t) {
+          const Share s = entry_share(n, c, t, w);
+          smallest = std::min(smallest, s.end - s.begin);
+          largest = std::max(largest, s.end - s.begin);
+          for (index i = s.begin; i < s.end; ++i) ++seen[std::size_t(i)];
+          if (n % kThirds == 0) {  // a vector: the same nodes in every component
+            const Share s0 = entry_share(n, 0, t, w);
+            EXPECT_EQ(s.begin - s0.begin, c * (n / kThirds));
+            EXPECT_EQ(s.end - s0.end, c * (n / kThirds));
+          }
+        }
+        EXPECT_LE(largest - smallest, 1) << "n " << n << ", " << w << " workers";
+      }
+      for (index i = 0; i < n; ++i) ASSERT_EQ(seen[std::size_t(i)], 1) << "entry " << i << " of " << n << ", " << w << " workers";
+    }
+}
+
+// ... and a worker's node rows (the apply, the transfers) are its nodes of
+// every component up to one row at each end: on the mesh levels of the
+// large runs, at the thread counts of servers
+TEST(Partition, RowSharesAreTheNodesOfTheEntryShares) {
+  for (int level : {8, 12, 14, 15}) {
+    const auto d = level_dims(level);
+    const index nx = d[0] + 1, rows = (d[1] + 1) * (d[2] + 1), N = nx * rows;
+    for (index w : {2, 16, 64, 128})
+      for (index t = 0; t < w; ++t) {
+        const Share r = host_share(rows, t, w), e = entry_share(3 * N, 0, t, w);
+        EXPECT_LT(std::abs(r.begin * nx - e.begin), nx) << "level " << level << ", worker " << t << " of " << w;
+        EXPECT_LT(std::abs(r.end * nx - e.end), nx) << "level " << level << ", worker " << t << " of " << w;
+      }
+  }
+}
+
+// A launch's workers run on their own shares: what for_each_entry's body
+// sees on worker t is t's entries, and sum_over_blocks adds every block
+// once, each on the worker that owns its first entry.
+TEST(Partition, LaunchesGiveEachThreadItsShare) {
+  const index n = 3 * 50001;
+  ASSERT_TRUE(worth_threads(double(n) * Cost{8, 0}));
+  std::vector<int> owner(std::size_t(n), -1);
+  int* o = owner.data();
+  for_each_entry(n, Cost{8, 0}, [=](index i) { o[i] = omp_get_thread_num(); });
+  const index w = omp_get_max_threads();
+  for (index t = 0; t < w; ++t)
+    for (index c = 0; c < kThirds; ++c) {
+      const Share s = entry_share(n, c, t, w);
+      for (index i = s.begin; i < s.end; ++i) ASSERT_EQ(owner[std::size_t(i)], t) << "entry " << i;
+    }
+  const real blocks = sum_over_blocks(
+      n, 1000, Cost{8, 0}, [&](index i0, index i1) { return real(i1 - i0) * (o[i0] == omp_get_thread_num() ? 1 : -1); },
+      [](index) { return real(1); });
+  EXPECT_EQ(blocks, real(n));
 }
 
 // the fork/join census (launch.hpp): each launch counted once, as a parallel
