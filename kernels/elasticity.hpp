@@ -23,6 +23,7 @@
 // elasticity_apply_ref is the textbook element loop (gather 24 values,
 // multiply by Ke, scatter-add), serial. It is the test oracle.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -116,26 +117,26 @@ struct RowBlock {
 };
 // The banded apply's sweep on the host: a worker's share s of the rows of
 // `rows` (numbered in order, iy fastest: host_share of its launch, launch.hpp)
-// as blocks f(RowBlock) in cache order: the rest of its first plane, then
-// its whole planes in bands of at most `band` rows, each band swept through
-// those planes (its three input planes stay in L2), then the start of its
-// last plane. Every row of s once.
+// as blocks f(RowBlock) in cache order: bands of at most `band` rows, each
+// swept through the share's planes in z order (the end of its first plane,
+// its whole planes, the start of its last), so that a band's three input
+// planes stay in L2 and its planes are read once. Every row of s once.
 template <class F>
 void for_each_row_band(const RowBlock& rows, Share s, index band, const F& f) {
   const index ny = rows.y_end - rows.y_begin;
   if (ny <= 0 || s.begin >= s.end) return;
-  index za = s.begin / ny;
-  const index ya = s.begin % ny, zb = s.end / ny, yb = s.end % ny;  // zb: rows [0, yb) of it
+  const index za = s.begin / ny, ya = s.begin % ny, zb = s.end / ny, yb = s.end % ny;  // zb: rows [0, yb) of it
   const auto block = [&](index z0, index z1, index y0, index y1) {
-    f(RowBlock{rows.z_begin + z0, rows.z_begin + z1, rows.y_begin + y0, rows.y_begin + y1});
+    if (z0 < z1 && y0 < y1) f(RowBlock{rows.z_begin + z0, rows.z_begin + z1, rows.y_begin + y0, rows.y_begin + y1});
   };
   if (za == zb) return block(za, za + 1, ya, yb);
-  if (ya > 0) block(za, za + 1, ya, ny), ++za;
-  if (za < zb) {
-    const index nb = (ny + band - 1) / band;
-    for (index b = 0; b < nb; ++b) block(za, zb, ny * b / nb, ny * (b + 1) / nb);
+  const index nb = (ny + band - 1) / band;
+  for (index b = 0; b < nb; ++b) {
+    const index y0 = ny * b / nb, y1 = ny * (b + 1) / nb;
+    block(za, za + 1, std::max(y0, ya), y1);
+    block(za + 1, zb, y0, y1);
+    block(zb, zb + 1, y0, std::min(y1, yb));
   }
-  if (yb > 0) block(zb, zb + 1, 0, yb);
 }
 template <class T>
 void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, T* y, const RowBlock& rows, const T* b = nullptr);
