@@ -98,7 +98,8 @@ constexpr Cost kResidualCost{72, 309};
 constexpr Cost kChebStepCost = kResidualCost + kChebStepExtraCost;
 template <class T>
 constexpr Cost apply_cost(const ApplyOut<T>& out) {
-  return out.dinv ? kChebStepCost : out.b ? kResidualCost : kApplyCost;
+  const OutKind k = kind(out);
+  return writes_d(k) ? kChebStepCost : k == OutKind::residual ? kResidualCost : kApplyCost;
 }
 
 // y = K x for output planes iz in [z_begin, z_end) (the whole grid with
