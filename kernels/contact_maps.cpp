@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #include "launch.hpp"
@@ -18,10 +19,14 @@ struct NodeStep {
 inline NodeStep node_step(real s, real phi, real x1, real x2, real x3, real x4, real r1, real r2, bool kink_contact) {
   const real z1 = x1 - r1 / s, z2 = x2 - r2 / s;
   const real nz = std::sqrt(z1 * z1 + z2 * z2);
-  const real t = s * nz > phi ? 1 - phi / (s * nz) : 0;
+  // t = 1 - phi / (s |z|) where positive, else 0 (no branch: where s |z| = 0
+  // the quotient is inf or NaN, and max gives 0 for both)
+  const real t = std::max(real(0), 1 - phi / (s * nz));
   // contact where lambda - s (u_z + g) > 0, and on the kink (= 0) if asked
   const real c = x4 - s * x3;
-  return {t * z1, t * z2, std::max(real(0), c), t == 0, kink_contact ? c >= 0 : c > 0};
+  // (the kink as a bitwise term: a choice between two comparisons is one
+  // GCC 12 does not vectorise)
+  return {t * z1, t * z2, std::max(real(0), c), t == 0, bool((c > 0) | (kink_contact & (c == 0)))};
 }
 }  // namespace
 
@@ -45,32 +50,52 @@ ResidualNorms approximation_step(index p, const ContactLaw& law, const real* sca
                                  const real* lambda, const real* r, real* v, real* w, real* d, std::uint8_t* status) {
   TRESCA_ASSERT(p >= 0 && (p == 0 || (law.phi != nullptr && law.gap != nullptr)));
   // per-node work in parallel, then the deterministic blocked sum of v.v.
-  // (A block per node: on a GPU one lane of a warp does a node. In simd
-  // lanes, for_each_entry, GCC 12's nvptx backend stops with an internal
-  // compiler error in make_decl_rtl; p is the contact face, small.)
-  // (The test oracle is the dense reference Newton in tests/test_newton.cpp.)
-  for_each_block(p, double(p) * kApproximationStepCost, [=](index i) {
-    // x3 enters through F_4 = u_z + g
-    const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + law.gap[i], x4 = lambda[i];
-    const real r1 = r[i], r2 = r[p + i];
-    const NodeStep paper = node_step(1, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact);
-    v[i] = paper.d1 - x1;
-    v[p + i] = paper.d2 - x2;
-    v[2 * p + i] = -(r[2 * p + i] - x4);
-    v[3 * p + i] = paper.d4 - x4;
-    const NodeStep unit = units ? node_step(units[i], law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact) : paper;
-    const real su = units ? units[i] : 1;
-    w[i] = su * (unit.d1 - x1);
-    w[p + i] = su * (unit.d2 - x2);
-    w[2 * p + i] = v[2 * p + i];
-    w[3 * p + i] = unit.d4 - x4;
-    const NodeStep step = scale ? (scale == units ? unit : node_step(scale[i], law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact))
-                                : paper;
-    d[i] = step.d1;
-    d[p + i] = step.d2;
-    d[2 * p + i] = step.d4;
-    status[i] = std::uint8_t((step.contact ? kContact : 0) | (step.stick ? kStick : 0));
-  });
+  // The three steps (s = 1, the units' s, the scale's s) are taken at every
+  // node, also where two coincide (a missing units or scale is s = 1), and
+  // whether units and scale are given is a compile-time choice of the body:
+  // a branch in the body would keep its loop out of the CPU's vectors (a
+  // conditional load), and a step chosen by a branch is a local struct that
+  // GCC 12's nvptx backend cannot place in a warp's lanes (an internal
+  // compiler error in make_decl_rtl). This file is compiled without
+  // floating-point contraction (CMakeLists.txt): GCC fuses the vectorised
+  // loop's multiply-adds differently from its scalar remainder's, and where
+  // the threads' shares cut the loop would then change a node's last bits
+  // with the thread count. (Oracles: the closed forms and the thread counts
+  // in tests/test_newton.cpp, ApproximationStep; the dense reference Newton
+  // there.)
+  auto sweep = [&](auto has_units, auto has_scale) {
+    for_each_entry(p, kApproximationStepCost, [=](index i) {
+      // x3 enters through F_4 = u_z + g
+      const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + law.gap[i], x4 = lambda[i];
+      const real r1 = r[i], r2 = r[p + i];
+      const real su = has_units ? units[i] : 1, ss = has_scale ? scale[i] : 1;
+      const NodeStep paper = node_step(1, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact);
+      const NodeStep unit = node_step(su, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact);
+      const NodeStep step = node_step(ss, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact);
+      v[i] = paper.d1 - x1;
+      v[p + i] = paper.d2 - x2;
+      v[2 * p + i] = -(r[2 * p + i] - x4);
+      v[3 * p + i] = paper.d4 - x4;
+      w[i] = su * (unit.d1 - x1);
+      w[p + i] = su * (unit.d2 - x2);
+      w[2 * p + i] = v[2 * p + i];
+      w[3 * p + i] = unit.d4 - x4;
+      d[i] = step.d1;
+      d[p + i] = step.d2;
+      d[2 * p + i] = step.d4;
+      status[i] = std::uint8_t((step.contact ? kContact : 0) | (step.stick ? kStick : 0));
+    });
+  };
+  using yes = std::true_type;
+  using no = std::false_type;
+  if (units && scale)
+    sweep(yes{}, yes{});
+  else if (units)
+    sweep(yes{}, no{});
+  else if (scale)
+    sweep(no{}, yes{});
+  else
+    sweep(no{}, no{});
   return {dot(4 * p, v, v), dot(4 * p, w, w)};
 }
 

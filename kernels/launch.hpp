@@ -233,9 +233,10 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
 #endif
   const detail::HostLaunch launch(double(n) * per_entry);
   detail::on_host_workers(launch.threads, [&](index t, index w) {
+    const Body b = body;  // (each worker's own copy: its captures in registers, not reloaded after every store)
     detail::for_entry_runs(n, t, w, [&](index i0, index i1) {
 #pragma omp simd
-      for (index i = i0; i < i1; ++i) body(i);
+      for (index i = i0; i < i1; ++i) b(i);
     });
   });
 }

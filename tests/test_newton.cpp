@@ -4,6 +4,7 @@
 // by LU, no reduction. Plus the KKT conditions, thread independence and the
 // paper's Table 1 mesh sizes.
 #include <gtest/gtest.h>
+#include <cmath>
 #include <cstdio>
 #include <omp.h>
 
@@ -489,6 +490,91 @@ TEST(SemismoothNewton, ResultsAgreeWithOneAndTwoThreads) {
   EXPECT_TRUE(a.newton.lambda == b.newton.lambda);
   EXPECT_TRUE(a.newton.history == b.newton.history);
   EXPECT_EQ(a.inner_iterations, b.inner_iterations);
+}
+
+// The approximation step (kernels/contact_maps.cpp) node by node against
+// method.md §4's closed forms written out here, in the metric s per node
+// (z = x_12 - r_12/s, d_12 = max(0, 1 - phi/(s|z|)) z, d_4 = max(0, x_4 -
+// s x_3)), on a contact face large enough to run threaded: every pointer
+// case (units, scale missing, given, the same array), nodes on the kink
+// (x_4 - s x_3 = 0 exactly) and nodes with z = 0 (with phi = 0 too), and the
+// same bits on 1, 2 and 3 threads (a vectorised loop with a scalar
+// remainder must round each node the same wherever the shares cut).
+TEST(ApproximationStep, MatchesTheClosedFormsOnEveryNodeAndIsTheSameOnAnyThreadCount) {
+  const index p = 20011;
+  std::vector<real> u = test::random_vector(3 * p, 11), lambda = test::random_vector(p, 12),
+                    r = test::random_vector(3 * p, 13), phi = test::random_vector(p, 14),
+                    gap = test::random_vector(p, 15), units = test::random_vector(p, 16),
+                    scale = test::random_vector(p, 17);
+  for (index i = 0; i < p; ++i) {
+    phi[i] = 0.5 * (phi[i] + 1);      // [0, 1]
+    gap[i] = 0.1 * gap[i];
+    units[i] = 1.25 + 0.75 * units[i];  // [0.5, 2]
+    scale[i] = 1.25 + 0.75 * scale[i];
+    if (i % 7 == 0) u[2 * p + i] = gap[i] = lambda[i] = 0;  // on the kink: x_4 - s x_3 = 0
+    if (i % 11 == 0) r[i] = u[i], r[p + i] = u[p + i];      // z = 0 at s = 1 ...
+    if (i % 22 == 0) phi[i] = 0;                           // ... with phi = 0: 0/0
+  }
+  struct Step {
+    real d1, d2, d4;
+    bool contact, stick;
+  };
+  auto closed_form = [&](index i, real s, bool kink) {
+    const real x3 = u[2 * p + i] + gap[i], z1 = u[i] - r[i] / s, z2 = u[p + i] - r[p + i] / s;
+    const real nz = std::sqrt(z1 * z1 + z2 * z2);
+    const real t = s * nz > phi[i] ? 1 - phi[i] / (s * nz) : 0;
+    const real c = lambda[i] - s * x3;
+    return Step{t * z1, t * z2, c > 0 ? c : 0, kink ? c >= 0 : c > 0, t == 0};
+  };
+  auto close = [](real a, real b) { return std::abs(a - b) <= 1e-14 * (1 + std::abs(b)); };
+  const int keep = omp_get_max_threads();
+  for (bool kink : {true, false})
+    for (int pointers = 0; pointers < 4; ++pointers) {
+      const real* su = pointers & 1 ? units.data() : nullptr;
+      const real* ss = pointers == 3 ? units.data() : pointers & 2 ? scale.data() : nullptr;
+      std::vector<std::vector<real>> v(3), w(3), d(3);
+      std::vector<std::vector<std::uint8_t>> status(3);
+      std::vector<ResidualNorms> norms(3);
+      for (int t = 0; t < 3; ++t) {
+        omp_set_num_threads(t + 1);
+        v[t].assign(4 * p, 0);
+        w[t].assign(4 * p, 0);
+        d[t].assign(3 * p, 0);
+        status[t].assign(p, 0);
+        norms[t] = approximation_step(p, ContactLaw{phi.data(), gap.data(), kink}, ss, su, u.data(), lambda.data(),
+                                      r.data(), v[t].data(), w[t].data(), d[t].data(), status[t].data());
+      }
+      omp_set_num_threads(keep);
+      for (int t = 1; t < 3; ++t) {
+        EXPECT_TRUE(v[t] == v[0] && w[t] == w[0] && d[t] == d[0] && status[t] == status[0]) << t + 1 << " threads";
+        EXPECT_EQ(norms[t].paper, norms[0].paper);
+        EXPECT_EQ(norms[t].consistent, norms[0].consistent);
+      }
+      int mismatches = 0;
+      index kinks = 0, sticks = 0;
+      for (index i = 0; i < p && mismatches < 5; ++i) {
+        const real x1 = u[i], x2 = u[p + i], x4 = lambda[i];
+        const Step paper = closed_form(i, 1, kink), unit = closed_form(i, su ? su[i] : 1, kink),
+                   step = closed_form(i, ss ? ss[i] : 1, kink);
+        const real s_u = su ? su[i] : 1;
+        const bool ok =
+            close(v[0][i], paper.d1 - x1) && close(v[0][p + i], paper.d2 - x2) &&
+            v[0][2 * p + i] == -(r[2 * p + i] - x4) && close(v[0][3 * p + i], paper.d4 - x4) &&
+            close(w[0][i], s_u * (unit.d1 - x1)) && close(w[0][p + i], s_u * (unit.d2 - x2)) &&
+            w[0][2 * p + i] == v[0][2 * p + i] && close(w[0][3 * p + i], unit.d4 - x4) && close(d[0][i], step.d1) &&
+            close(d[0][p + i], step.d2) && close(d[0][2 * p + i], step.d4) &&
+            status[0][i] == ((step.contact ? kContact : 0) | (step.stick ? kStick : 0));
+        if (!ok) ++mismatches;
+        EXPECT_TRUE(ok) << "node " << i << " kink " << kink << " pointers " << pointers;
+        kinks += lambda[i] == 0 && u[2 * p + i] == 0 && gap[i] == 0;
+        sticks += step.stick;
+      }
+      EXPECT_GT(kinks, p / 8);
+      EXPECT_GT(sticks, p / 12);  // (the z = 0 nodes at least, where the step's s is 1)
+      real vv = 0;
+      for (real x : v[0]) vv += x * x;
+      EXPECT_NEAR(norms[0].paper, vv, 1e-12 * vv);
+    }
 }
 
 // Young's modulus from 2.1e9 to 1e16 Pa (issue 11: E >= 1e13 used to
