@@ -91,7 +91,7 @@ Transfer slice_rows(const Transfer& whole, index f0, index f1, index c0, index c
 }
 
 template <class T>
-void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool accumulate, unsigned zero_faces) {
+void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, const T* base, unsigned zero_faces) {
   TRESCA_ASSERT(comps >= 1 && comps <= 3 && index(t.axis[0].j0.size()) == t.fine.nx());
   // Per fine row (iy, iz): combine the 4 coarse rows of its y/z support into
   // one coarse-length row buffer (contiguous, vectorised), then interpolate
@@ -114,12 +114,14 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
       const T* u = coarse + a * Nc;
 #pragma omp simd
       for (index j = 0; j < cnx; ++j) s[j] = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
-      T* v = fine + a * Nf + fnx * (iy + fny * iz);
+      const index at = a * Nf + fnx * (iy + fny * iz);
+      T* v = fine + at;
+      const T* v0 = base ? base + at : nullptr;
       TRESCA_DEVICE_LANES
       for (index ix = 0; ix < fnx; ++ix) {
         const index j = X.j0[ix];
         const T wx = T(X.w[ix]);
-        const T p = (accumulate ? v[ix] : T(0)) + (1 - wx) * s[j] + wx * s[j + 1];
+        const T p = (v0 ? v0[ix] : T(0)) + (1 - wx) * s[j] + wx * s[j + 1];
         v[ix] = m.at(ix) ? T(0) : p;
       }
     }
@@ -128,10 +130,10 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool acc
                                  fine_row);
 }
 
-template void prolongate<double>(const Transfer&, int, const double*, double*, bool, unsigned);
-template void prolongate<float>(const Transfer&, int, const float*, float*, bool, unsigned);
+template void prolongate<double>(const Transfer&, int, const double*, double*, const double*, unsigned);
+template void prolongate<float>(const Transfer&, int, const float*, float*, const float*, unsigned);
 
-void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate) {
+void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine, const real* base) {
   const GridDims &f = t.fine, &c = t.coarse;
   for (int a = 0; a < comps; ++a)
     for (index iz = 0; iz < f.nz(); ++iz)
@@ -146,8 +148,8 @@ void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine
             s += w * coarse[a * c.nodes() +
                             c.node(t.axis[0].j0[ix] + bx, t.axis[1].j0[iy] + by, t.axis[2].j0[iz] + bz)];
           }
-          real& out = fine[a * f.nodes() + f.node(ix, iy, iz)];
-          out = accumulate ? out + s : s;
+          const index at = a * f.nodes() + f.node(ix, iy, iz);
+          fine[at] = base ? base[at] + s : s;
         }
 }
 

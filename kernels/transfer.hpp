@@ -66,15 +66,16 @@ Transfer build_transfer(const GridDims& fine, const GridDims& coarse);
 // rank's ghost rows, core/parallel). Box dims are t's with ey = rows - 1.
 Transfer slice_rows(const Transfer& t, index f0, index f1, index c0, index c1);
 
-// fine = P coarse (or fine += P coarse with accumulate), for `comps` components.
-// The optimised kernels are instantiated for T = double and float. With
-// zero_faces (Face bits of the output grid), the output's entries on those
-// faces are written 0 instead, in the same sweep: the transfer followed by
+// fine = base + P coarse (base nullptr: fine = P coarse; base may be fine
+// itself: fine += P coarse), for `comps` components. The optimised kernels
+// are instantiated for T = double and float. With zero_faces (Face bits of
+// the output grid), the output's entries on those faces are written 0
+// instead, in the same sweep: the transfer followed by
 // zero_constrained(output grid, zero_faces, output), one launch.
 template <class T>
-void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, bool accumulate = false,
+void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, const T* base = nullptr,
                 unsigned zero_faces = 0);
-void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine, bool accumulate = false);
+void prolongate_ref(const Transfer& t, int comps, const real* coarse, real* fine, const real* base = nullptr);
 // coarse = P^T fine
 template <class T>
 void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse, unsigned zero_faces = 0);

@@ -39,7 +39,9 @@ void reciprocal_or_zero(index n, const real* x, To* y);
 // x += a p; r -= a q; returns r.r
 real cg_update(index n, real a, const real* p, const real* q, real* x, real* r);
 real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real* r);
-// d = s d + t dinv .* r; x += d   (T = double, float)
+// d = s d + t dinv .* r; x += d   (T = double, float): a smoother step's
+// update unfused from its residual (the V-cycle runs the fused step of the
+// apply, apply_out.hpp; this is bench_kernels' ChebStepUnfused reference)
 template <class T>
 void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x);
 // first Chebyshev step, d = t dinv .* r, from x = 0 (x = d; r = b) or from a

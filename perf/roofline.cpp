@@ -158,7 +158,7 @@ int main(int argc, char** argv) {
     add("bottom block", 3.0 * M, double(M) * kBottomBlockCost,
         [&] { bottom_block_apply(g, B.data(), x.data(), operator_out(y.data())); });
     add("restriction", dofs, dofs * kRestrictCost, [&] { restrict_to_coarse(t, 3, x.data(), xc.data()); });
-    add("prolongation (+=)", dofs, dofs * kProlongateCost, [&] { prolongate(t, 3, xc.data(), y.data(), true); });
+    add("prolongation (+=)", dofs, dofs * kProlongateCost, [&] { prolongate(t, 3, xc.data(), y.data(), y.data()); });
     real sink = 0;
     add("dot", dofs, dofs * kDotCost, [&] { sink += 1e-300 * dot(n, x.data(), b.data()); });
     add("axpy", dofs, dofs * kAxpyCost, [&] { axpy(n, 1e-9, x.data(), y.data()); });

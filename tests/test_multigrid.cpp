@@ -7,11 +7,69 @@
 #include "core/solvers/cg.hpp"
 #include "core/multigrid/interior.hpp"
 #include "core/multigrid/multigrid.hpp"
+#include "core/multigrid/smoothing.hpp"
 #include "core/fem/problem.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"
 
 namespace tresca {
+
+// chebyshev_smooth against the textbook Chebyshev semi-iteration (rho_0 =
+// 1/sigma, d_0 = Dinv r_0 / theta; rho_k = 1/(2 sigma - rho_{k-1}), d_k =
+// rho_k rho_{k-1} d_{k-1} + 2 rho_k / delta Dinv r_k; x += d), on a small SPD
+// tridiagonal matrix: every degree 1..6, from zero and from a guess entering
+// in x or in r; the iterate leaves in x, and where the guess enters where
+// chebyshev_entry says every step is a fused one (no residual formed)
+TEST(Chebyshev, EveryDegreeAndEntryGivesTheTextbookIterate) {
+  const index n = 40;
+  std::vector<real> dinv(n), b = test::random_vector(n, 21), guess = test::random_vector(n, 22);
+  auto A = [&](const real* x, index i) {
+    return (2.5 + 0.01 * real(i)) * x[i] - (i > 0 ? x[i - 1] : 0) - (i + 1 < n ? x[i + 1] : 0);
+  };
+  for (index i = 0; i < n; ++i) dinv[i] = 1 / (2.5 + 0.01 * real(i));
+  const real lmax = 2.2, range = 10;
+  for (int degree = 1; degree <= 6; ++degree)
+    for (int entry = 0; entry < 3; ++entry) {  // 0: zero guess, 1: guess in x, 2: guess in r
+      // the textbook
+      std::vector<real> want(n, 0.0), dk(n), rk(n);
+      if (entry > 0) want = guess;
+      const real lmin = lmax / range, theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
+      real rho = 1 / sigma;
+      for (int k = 0; k < degree; ++k) {
+        for (index i = 0; i < n; ++i) rk[i] = b[i] - A(want.data(), i);
+        const real rho_new = k == 0 ? rho : 1 / (2 * sigma - rho);
+        for (index i = 0; i < n; ++i)
+          dk[i] = (k == 0 ? 0 : rho_new * rho * dk[i]) + (k == 0 ? 1 / theta : 2 * rho_new / delta) * dinv[i] * rk[i];
+        rho = rho_new;
+        for (index i = 0; i < n; ++i) want[i] += dk[i];
+      }
+      // chebyshev_smooth
+      std::vector<real> x(n, std::nan("")), r(n, std::nan("")), d(n, std::nan(""));
+      real* in = entry == 1 ? x.data() : entry == 2 ? r.data() : nullptr;
+      if (in) std::copy(guess.begin(), guess.end(), in);
+      int residuals = 0, steps = 0;
+      chebyshev_smooth<real>(
+          n, lmax, range, degree, entry == 0, dinv.data(), b.data(), x.data(), r.data(), d.data(),
+          [&](real* from, real* to) {
+            ++residuals;
+            for (index i = 0; i < n; ++i) to[i] = b[i] - A(from, i);
+          },
+          [&](real* from, real* to, real s, real t) {
+            ++steps;
+            ASSERT_NE(from, to);
+            for (index i = 0; i < n; ++i) {
+              d[i] = (s == 0 ? 0 : s * d[i]) + t * dinv[i] * (b[i] - A(from, i));
+              to[i] = from[i] + d[i];
+            }
+          },
+          in);
+      for (index i = 0; i < n; ++i)
+        ASSERT_NEAR(x[i], want[i], 1e-13 * (1 + std::abs(want[i]))) << "degree " << degree << " entry " << entry;
+      const bool fused_entry = entry == 0 || in == chebyshev_entry(degree, x.data(), r.data());
+      EXPECT_EQ(residuals, fused_entry ? 0 : 1) << "degree " << degree << " entry " << entry;
+      EXPECT_EQ(steps, degree - (entry == 0 || !fused_entry ? 1 : 0)) << "degree " << degree << " entry " << entry;
+    }
+}
 
 TEST(MultigridCG, MatchesSparseDirectSolveOnOddMeshes) {
   const index sizes[][3] = {{7, 3, 5}, {9, 5, 5}, {23, 12, 12}};

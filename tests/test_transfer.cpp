@@ -26,11 +26,14 @@ TEST(Transfer, OptimisedEqualsReferenceOnNonNestedGrids) {
     restrict_to_coarse(t, 2, f.data(), rc.data());
     restrict_to_coarse_ref(t, 2, f.data(), rcr.data());
     EXPECT_LT(max_abs_diff(pf, pfr), 1e-14);
-    // accumulate: fine += P coarse
-    std::vector<real> acc(f), accr(f);
-    prolongate(t, 2, c.data(), acc.data(), true);
-    prolongate_ref(t, 2, c.data(), accr.data(), true);
+    // onto a base: fine += P coarse in place, and out = f + P coarse into
+    // another vector, the same bits
+    std::vector<real> acc(f), accr(f), out(f.size(), -7.0);
+    prolongate(t, 2, c.data(), acc.data(), acc.data());
+    prolongate_ref(t, 2, c.data(), accr.data(), accr.data());
+    prolongate(t, 2, c.data(), out.data(), f.data());
     EXPECT_LT(max_abs_diff(acc, accr), 1e-14);
+    EXPECT_EQ(out, acc);
     for (size_t i = 0; i < f.size(); ++i) EXPECT_NEAR(acc[i], f[i] + pfr[i], 1e-14);
     EXPECT_LT(max_abs_diff(rc, rcr), 1e-13);
     // <P c, f> = <c, P^T f>
@@ -50,10 +53,12 @@ void check_zero_faces() {
     const auto cd = random_vector(3 * t.coarse.nodes(), 3), fd = random_vector(3 * t.fine.nodes(), 4);
     const std::vector<T> c(cd.begin(), cd.end()), f(fd.begin(), fd.end());
     for (unsigned faces = 0; faces < 64; faces += (faces < 8 ? 1 : 7)) {
-      std::vector<T> pf(f), want_pf(f), rc(c.size()), want_rc(c.size());
-      prolongate<T>(t, 3, c.data(), pf.data(), true, faces);
-      prolongate<T>(t, 3, c.data(), want_pf.data(), true);
+      std::vector<T> pf(f), want_pf(f), out(f.size(), T(-7)), rc(c.size()), want_rc(c.size());
+      prolongate<T>(t, 3, c.data(), pf.data(), pf.data(), faces);
+      prolongate<T>(t, 3, c.data(), out.data(), f.data(), faces);  // (out of place)
+      prolongate<T>(t, 3, c.data(), want_pf.data(), want_pf.data());
       zero_constrained<T>(t.fine, faces, want_pf.data());
+      EXPECT_EQ(out, want_pf) << "prolongation out of place, faces " << faces;
       restrict_to_coarse<T>(t, 3, f.data(), rc.data(), faces);
       restrict_to_coarse<T>(t, 3, f.data(), want_rc.data());
       zero_constrained<T>(t.coarse, faces, want_rc.data());

@@ -323,7 +323,7 @@ void Multigrid::residual(int l, const T* b, T* x, T* r) const {
 }
 
 template <class T>
-void Multigrid::smooth(int l, bool zero_guess) const {
+void Multigrid::smooth(int l, bool zero_guess, const T* in) const {
   const Work<T>& w = work<T>()[l];
   ScopedTimer t(Kernel::smoother);
   const ElasticityOperator& A = levels_[l].A;
@@ -333,7 +333,8 @@ void Multigrid::smooth(int l, bool zero_guess) const {
       [&](T* x, T* y, T s, T t) {
         A.update_ghosts(x);
         A.chebyshev_step(w.bp, x, y, w.dinv.data(), w.d.data(), s, t);
-      });
+      },
+      in);
 }
 
 template <class T>
@@ -356,8 +357,9 @@ void Multigrid::restrict_residual(int l) const {
 }
 
 template <class T>
-void Multigrid::prolongate_correction(int l) const {
-  // x += P x_c (the coarse rows other ranks own fetched first); the
+T* Multigrid::prolongate_correction(int l) const {
+  // x + P x_c (the coarse rows other ranks own fetched first), written where
+  // the post-smoother's steps all fuse (smoothing.hpp: x itself or r); the
   // correction vanishes on constrained faces (they are interpolated from
   // constrained coarse nodes only), the mask makes it exact
   const Work<T>& w = work<T>()[l];
@@ -371,7 +373,9 @@ void Multigrid::prolongate_correction(int l) const {
     coarse = w.coarse_rows.data();
   }
   TRESCA_ASSERT(k.prolong_t.fine.nodes() == A.grid().nodes() && k.prolong_t.fine.ey == A.grid().ey);
-  prolongate<T>(k.prolong_t, 3, coarse, w.xp, true, A.faces());  // and zero on A's constrained faces
+  T* to = chebyshev_entry(opt_.degree, w.xp, w.r.data());
+  prolongate<T>(k.prolong_t, 3, coarse, to, w.xp, A.faces());  // and zero on A's constrained faces
+  return to;
 }
 
 template <class T>
@@ -401,8 +405,7 @@ void Multigrid::vcycle(int l) const {
   } else {
     vcycle<T>(l + 1);
   }
-  prolongate_correction<T>(l);
-  smooth<T>(l, false);
+  smooth<T>(l, false, prolongate_correction<T>(l));
 }
 
 void Multigrid::apply(const real* r, real* z) const {

@@ -46,9 +46,12 @@
 // Cost per V-cycle on a level with n dofs: (2*degree) applies of A, plus
 // residual apply, one restriction and one prolongation: about
 // (2*degree+1) * 306/3 + 20 flops per dof; the hierarchy adds about 1/7.
-// The smoother's steps after the first run fused into the apply, in pairs
-// (smoothing.hpp, kernels/apply_out.hpp): no residual vector written and
-// read back, about 30 % less memory traffic a step.
+// The smoother's steps run fused into the apply (smoothing.hpp,
+// kernels/apply_out.hpp): no residual vector written and read back, about
+// 30 % less memory traffic a step; only the zero guess's first step is a
+// vector update. The prolongation writes the corrected iterate into the
+// vector from which the post-smoother's steps, alternating between two
+// vectors, end in x, so that smoother needs no residual sweep either.
 #pragma once
 #include <Eigen/SparseCholesky>
 #include <functional>
@@ -179,13 +182,13 @@ class Multigrid : public LinearOperator {
   template <class T>
   void residual(int l, const T* b, T* x, T* r) const;
   template <class T>
-  void smooth(int l, bool zero_guess) const;
+  void smooth(int l, bool zero_guess, const T* in = nullptr) const;
   template <class T>
   void vcycle(int l) const;
   template <class T>
   void restrict_residual(int l) const;
   template <class T>
-  void prolongate_correction(int l) const;
+  T* prolongate_correction(int l) const;  // into the post-smoother's entry; returns it
   void factor_coarse();
   void estimate_lmax(int l);
   const Comm& comm() const { return *grids_->comm; }

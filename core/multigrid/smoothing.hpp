@@ -4,11 +4,13 @@
 //   targeting [lmax/range, lmax]: x_{k+1} = x_k + d_{k+1} with
 //   d_{k+1} = s_k d_k + t_k Dinv (b - A x_k). `step(x, y, s, t)` is one step
 //   from x into y != x with the residual never stored (the operator's
-//   chebyshev_step: kernels/apply_out.hpp); the steps run in pairs x -> r ->
-//   x, so r serves as the second iterate; a step left over (an even degree,
-//   or the first step of a nonzero guess with an odd one) forms
-//   `residual(x, r)`, r = b - A x, and updates x in place. From a zero
-//   guess the first step needs no residual (x = d = t Dinv b).
+//   chebyshev_step: kernels/apply_out.hpp; s = 0 for the first); the steps
+//   go back and forth between x and r, and the iterate leaves in x. It
+//   enters as 0 (zero_guess; the first step needs no residual, x = d =
+//   t Dinv b, and goes to whichever vector makes the rest end in x) or in
+//   `in` (x or r): in chebyshev_entry(degree, x, r) every step is a fused
+//   one; in the other vector the first step forms a residual and updates the
+//   iterate in place (`residual(x, y)`, y = b - A x, into the free vector).
 // * lanczos_lmax: the largest eigenvalue of D^{-1}A from 15 steps of
 //   Jacobi-PCG (Lanczos), times 1.15, at least 2.3; dots through `reduce`
 //   (the sum over the ranks of a split level; null: one part);
@@ -24,9 +26,17 @@
 
 namespace tresca {
 
+// where a nonzero iterate should enter chebyshev_smooth so that every step
+// is fused (the steps alternate between x and r and end in x)
+template <class T>
+T* chebyshev_entry(int degree, T* x, T* r) {
+  return degree % 2 == 0 ? x : r;
+}
+
 template <class T, class Residual, class Step>
 void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_guess, const T* dinv, const T* b, T* x, T* r,
-                      T* d, Residual&& residual, Step&& step) {
+                      T* d, Residual&& residual, Step&& step, const T* in = nullptr) {
+  TRESCA_ASSERT(degree >= 1);
   const real lmin = lmax / range;
   const real theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
   // step k's coefficients: d = s d + t Dinv r (s = 0 for the first, k = 0)
@@ -37,31 +47,30 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
     t = 2 * rho_new / delta;
     rho = rho_new;
   };
+  auto other = [&](T* v) { return v == x ? r : x; };
+  T* at = x;  // where the iterate is
   int k = 0;
   if (zero_guess) {  // from x = 0: no residual to form
-    cheb_first<T>(n, T(t), dinv, b, d, x);
+    at = chebyshev_entry(degree - 1, x, r);
+    cheb_first<T>(n, T(t), dinv, b, d, at);
     next();
     k = 1;
+  } else {
+    at = in == r ? r : x;
+    if (at != chebyshev_entry(degree, x, r)) {  // the first step in place
+      residual(at, other(at));
+      cheb_first<T>(n, T(t), dinv, other(at), d, at, false);
+      next();
+      k = 1;
+    }
   }
-  if ((degree - k) % 2 == 1) {  // the odd step out, in place
-    residual(x, r);
-    if (k == 0)
-      cheb_first<T>(n, T(t), dinv, r, d, x, false);
-    else
-      cheb_update<T>(n, T(s), T(t), dinv, r, d, x);
-    next();
-    ++k;
-  }
-  for (; k < degree; k += 2) {  // the rest fused in pairs, x -> r -> x: the iterate ends in x
-    step(x, r, T(s), T(t));
-    next();
-    step(r, x, T(s), T(t));
+  for (; k < degree; ++k) {
+    step(at, other(at), T(s), T(t));
+    at = other(at);
     next();
   }
 }
 
-// r: the start vector (overwritten); apply(p, q): q = A p (p is the
-// estimate's own vector: apply may update its ghost entries)
 real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const Field<real>& dinv,
                   Field<real> r, const Reduction* reduce = nullptr);
 
