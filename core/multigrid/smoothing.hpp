@@ -48,21 +48,18 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
     rho = rho_new;
   };
   auto other = [&](T* v) { return v == x ? r : x; };
-  T* at = x;  // where the iterate is
+  // where the iterate is: from a zero guess, where the first step puts it
+  T* at = zero_guess ? chebyshev_entry(degree - 1, x, r) : in == r ? r : x;
   int k = 0;
   if (zero_guess) {  // from x = 0: no residual to form
-    at = chebyshev_entry(degree - 1, x, r);
     cheb_first<T>(n, T(t), dinv, b, d, at);
     next();
     k = 1;
-  } else {
-    at = in == r ? r : x;
-    if (at != chebyshev_entry(degree, x, r)) {  // the first step in place
-      residual(at, other(at));
-      cheb_first<T>(n, T(t), dinv, other(at), d, at, false);
-      next();
-      k = 1;
-    }
+  } else if (at != chebyshev_entry(degree, x, r)) {  // the first step in place
+    residual(at, other(at));
+    cheb_first<T>(n, T(t), dinv, other(at), d, at, false);
+    next();
+    k = 1;
   }
   for (; k < degree; ++k) {
     step(at, other(at), T(s), T(t));
@@ -71,6 +68,8 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
   }
 }
 
+// r: the start vector (overwritten); apply(p, q): q = A p (p is the
+// estimate's own vector: apply may update its ghost entries)
 real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const Field<real>& dinv,
                   Field<real> r, const Reduction* reduce = nullptr);
 
