@@ -213,6 +213,20 @@ TEST(TrescaDriver, TakesATinyButNonzeroNumber) {
   expect_run("tresca --dims 4x2x2 --quiet --phi 1e-320", 0, "");
 }
 
+TEST(TrescaDriver, WithoutLoadTheBodyStaysAtRest) {
+  // b~ = 0: nested iteration (and the Coulomb fixed point) once stopped with
+  // "an initial iterate u0 needs force_scale" (exit 2); u = 0, lambda = 0
+  // is the answer, with Newton's accuracies scaled by 1 N
+  for (const char* law : {"", " --coulomb 0.3", " --coulomb 0.3 --coulomb-method fixed-point"}) {
+    const CmdResult r = run(std::string("tresca --dims 24x12x12 --load-scale 0") + law);
+    EXPECT_EQ(r.status, 0) << law << "\n" << r.out;
+    EXPECT_NE(r.out.find("nested: mesh 12x6x6 solved"), std::string::npos) << law << "\n" << r.out;
+    EXPECT_NE(r.out.find("converged after 0 Newton iterations"), std::string::npos) << law << "\n" << r.out;
+    EXPECT_NE(r.out.find("min ux 0.000000e+00, max uz 0.000000e+00, sum lambda 0.000000e+00"), std::string::npos)
+        << law << "\n" << r.out;
+  }
+}
+
 TEST(TrescaDriver, NearlyIncompressibleMaterialEndsInSecondsWithAVerifiedAnswer) {
   // issue 11: nu = 0.4999 on 16x8x8 ground on for 825 s before stagnation;
   // then two Newton steps in a row with the boundary CG at its limit stopped

@@ -199,7 +199,7 @@ SolveStats scale_of_load(const SteklovPoincare& S, const RunOptions& opt, Newton
     Field<real> btilde;
     cond = S.condensed_load(opt.scale_rtol, btilde, opt.keep_interior_load ? &R.interior_load : nullptr,
                             start.load_guess.empty() ? nullptr : start.load_guess.data());
-    newton.force_scale = std::sqrt(S.sum(dot(index(btilde.size()), btilde.data(), btilde.data())));
+    newton.force_scale = force_scale_of(std::sqrt(S.sum(dot(index(btilde.size()), btilde.data(), btilde.data()))));
   }
   start.load_guess = {};
   return cond;

@@ -498,8 +498,8 @@ bool NewtonSolve::start() {
     x.r = placed_field<real>(*opt.r0);
   else if (!refresh(opt.initial_residual_rtol))
     return false;
-  R.force_scale = opt.force_scale > 0 ? opt.force_scale : std::sqrt(S.sum(dot(n3, x.r.data(), x.r.data())));
-  if (!(R.force_scale > 0)) R.force_scale = 1;
+  R.force_scale =
+      opt.force_scale > 0 ? opt.force_scale : force_scale_of(std::sqrt(S.sum(dot(n3, x.r.data(), x.r.data()))));
   fscale = R.force_scale;
   r_err = (opt.r0 ? (opt.r0_accuracy > 0 ? opt.r0_accuracy : opt.residual_accuracy) : opt.initial_residual_rtol) *
           fscale;

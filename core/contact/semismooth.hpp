@@ -90,6 +90,11 @@ enum class StepScaling { paper, diagonal };
 // 1e4 N off); the paper's for --table only.
 enum class StopRule { consistent, paper };
 
+// The scale of Newton's accuracies from the norm |b̃| [N] of the condensed
+// load: |b̃| itself, or 1 N where there is no load at all (b̃ = 0, whose
+// solution u = 0 any scale accepts).
+inline real force_scale_of(real btilde_norm) { return btilde_norm > 0 ? btilde_norm : real(1); }
+
 struct NewtonOptions {
   real eps = 1e-6;  // [N]
   real rtol = 0;    // stop at |w| <= max(eps, rtol |w_0|) (0: absolute)
@@ -143,7 +148,8 @@ struct NewtonOptions {
   // steklov.hpp: residual), e.g. a coarser mesh's, interpolated
   const Field<real>* body0 = nullptr;
   // |b̃| [N], the scale of r's absolute accuracy; 0: |r| at x0 = 0 (= |b̃|).
-  // Required with u0 (e.g. from a loose SteklovPoincare::condensed_load).
+  // Required with u0 (e.g. from a loose SteklovPoincare::condensed_load,
+  // through force_scale_of).
   real force_scale = 0;
   // optional, with body0 and force_scale: r0 = S u0 - b̃ of that body to
   // residual_accuracy, e.g. an earlier solve's NewtonResult::r and ::body
