@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
     if (comm.rank() == 0) {
       std::printf("mesh            : %s (level %d)\n", dims_string(spec).c_str(), spec.level);
       std::printf("nodes / dofs    : %lld / %lld\n", (long long)P.nodes(), (long long)P.dofs());
-      std::printf("ranks x threads : %d x %d%s\n", comm.size(), threads, comm.distributed() ? " (y-slabs)" : "");
+      std::printf("ranks x threads : %d x %d (%s)\n", comm.size(), threads, rank_layout(P.grid, comm, "rank 0 solves the whole mesh").c_str());
       std::printf("kernels on      : %s\n", device.c_str());
       std::printf("multigrid       : %s\n", mg.describe().c_str());
       std::printf("cg              : %s after %d iterations\n", to_string(st.reason), st.iterations);

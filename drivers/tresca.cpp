@@ -386,9 +386,11 @@ void print_header(const Command& c, const ThreadPlacement& placement, const Comm
               dims_string(spec).c_str(), spec.level >= 0 ? std::to_string(spec.level).c_str() : "-",
               (long long)spec.nodes(), (long long)spec.contact_nodes(), (long long)spec.free_dofs(), friction,
               to_string(spec.obstacle.kind), c.opt.newton.eps, c.threads,
-              comm.distributed() ? (" per rank x " + std::to_string(comm.size()) + " MPI ranks (y-slabs)").c_str() : "");
+              comm.distributed() ? (" per rank x " + std::to_string(comm.size()) + " MPI ranks (" + run_rank_layout(spec) + ")")
+                                     .c_str() : "");
   std::printf("        estimated peak memory %.2f GB%s; kernels: %s; %s\n",
-              estimated_memory_bytes_per_rank(spec, comm.size()) / 1e9, comm.distributed() ? " per rank" : "",
+              estimated_memory_bytes_per_rank(spec, split_over(grid_of(spec), comm).size()) / 1e9,
+              comm.distributed() ? " per rank" : "",
               build_info().c_str(), omp_wait_setting().c_str());
   std::printf("        %s; %s; kernels on %s\n", placement.describe().c_str(), huge_page_setting().c_str(),
               c.device.c_str());

@@ -257,6 +257,10 @@ void gather_contact_values(const SteklovPoincare& S, ContactConditions& law, Run
 
 }  // namespace
 
+std::string run_rank_layout(const ProblemSpec& spec) {
+  return rank_layout(grid_of(spec), Comm::world(), "each rank solves the whole mesh");
+}
+
 RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   RunResult R;
   R.friction = opt.friction;

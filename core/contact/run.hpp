@@ -137,5 +137,8 @@ struct RunResult {
 ContactConditions contact_conditions(const ProblemSpec& spec);
 
 RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt);
+// how run_tresca's ranks hold the mesh of spec (multigrid.hpp: rank_layout;
+// a mesh too small to split is solved whole by every rank)
+std::string run_rank_layout(const ProblemSpec& spec);
 
 }  // namespace tresca

@@ -67,6 +67,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["eps"] = eps;
   j["threads"] = threads;  // per rank
   j["ranks"] = Comm::world().size();
+  j["rank_layout"] = run_rank_layout(spec);
   if (Comm::world().distributed()) {  // what rank 0 sent over the whole run (comm.hpp)
     const CommCounters& c = comm_counters();
     j["communication_rank0"] = {{"messages", c.messages}, {"bytes", c.bytes}, {"allreduces", c.allreduces},

@@ -106,6 +106,12 @@ const Comm& split_over(const GridDims& g, const Comm& comm) {
   return worth_distributing(g, comm) ? comm : Comm::self();
 }
 
+std::string rank_layout(const GridDims& g, const Comm& comm, const std::string& whole) {
+  if (!comm.distributed()) return "one rank";
+  if (worth_distributing(g, comm)) return "y-slabs";
+  return whole + ": too small to split, under 2 node rows in y or 2048 nodes a rank";
+}
+
 std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, index coarse_nodes, const Comm& comm,
                                                           index min_nodes_per_rank) {
   auto h = std::make_shared<GridHierarchy>();

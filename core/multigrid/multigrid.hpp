@@ -83,6 +83,10 @@ bool worth_distributing(const GridDims& g, const Comm& comm, index min_nodes_per
 // the ranks a fine grid's operators are split over: comm where
 // worth_distributing, else Comm::self() (every rank holds the grid whole)
 const Comm& split_over(const GridDims& g, const Comm& comm);
+// how the ranks of comm hold g, for a run's header: "y-slabs", or `whole`
+// (what the run does with a grid it does not split: "each rank solves the
+// whole mesh") and why; "one rank" on one
+std::string rank_layout(const GridDims& g, const Comm& comm, const std::string& whole);
 
 // The grids of a multigrid hierarchy, how each is held by the ranks, and
 // the transfers between them.
