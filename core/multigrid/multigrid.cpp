@@ -448,8 +448,10 @@ std::string Multigrid::describe() const {
   for (const GridHierarchy::Level& h : grids_->levels)
     os << " " << h.grid.ex << "x" << h.grid.ey << "x" << h.grid.ez << (h.distributed ? "(d)" : "");
   os << " (" << to_string(opt_.precision) << " precision";
-  if (comm().distributed())
+  if (comm().distributed() && grids_->distributed_levels() > 0)
     os << "; (d): split over " << comm().size() << " ranks, the others agglomerated on rank 0";
+  else if (comm().distributed())
+    os << "; every level on rank 0";
   os << ")";
   return os.str();
 }
