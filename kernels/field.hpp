@@ -53,13 +53,14 @@ void space_zero(Space s, void* p, std::size_t bytes);
 
 // Blocks freed by Fields are kept for the next Field of the same size
 // (launch.cpp: large host blocks and every device block; the memory held
-// stays under the largest the live Fields ever needed). What that saved so
-// far, in one space:
+// stays under held_limit_bytes, the most the live Fields ever needed plus
+// a slack). What that saved so far, in one space:
 struct BlockReuse {
   long long requests = 0, reused = 0;  // blocks asked for, and of them, blocks handed out again
   double reused_bytes = 0;             // their bytes: memory not faulted in (or cudaMalloc'ed) again
   double kept_bytes = 0;               // bytes kept now for reuse
-  double live_bytes = 0, peak_bytes = 0;  // in live Fields now, and the most ever (kept + live stays below it)
+  double live_bytes = 0, peak_bytes = 0;  // in live Fields now, and the most ever
+  double held_limit_bytes = 0;            // live + kept stays below it (peak + slack)
 };
 BlockReuse block_reuse(Space s);
 
@@ -87,11 +88,16 @@ class Field {
     n_ = o.n_;
   }
   Field(Field&& o) noexcept { swap(o); }
+  // (into its own storage where that has o's size in o's space: no new block)
   Field& operator=(const Field& o) {
-    if (this != &o) {
-      Field t(o);
-      swap(t);
+    if (this == &o) return *this;
+    if (cap_ == o.n_ && cap_ > 0 && space_ == o.space_) {
+      space_copy(space_, p_, o.space_, o.p_, bytes(o.n_));
+      n_ = o.n_;
+      return *this;
     }
+    Field t(o);
+    swap(t);
     return *this;
   }
   Field& operator=(Field&& o) noexcept {

@@ -219,9 +219,14 @@ void raw_free(Space s, void* p, std::size_t bytes) noexcept {
 // blocks and all device blocks are kept; small host blocks come from malloc,
 // which keeps them itself.
 //
-// The memory held (live blocks + kept ones) never passes the largest the
-// live blocks ever needed: before a fresh block is made, kept blocks are
-// given back, oldest first, until it fits under that peak.
+// The memory held (live blocks + kept ones) never passes the most the live
+// blocks ever needed plus a slack, the largest block or a 16th of that
+// peak, whichever is more: before a fresh block is made, kept blocks are
+// given back, oldest first, until it fits. The slack is what lets a
+// solve's temporaries of different sizes, made and dropped in turn, be
+// kept: with the live peak alone as the bound each evicted the one before
+// (every contact Newton step made about 50 fresh blocks on the device and
+// its one or two largest vectors on the host; RESULTS.md §0t).
 class BlockCache {
  public:
   explicit BlockCache(Space s) : space_(s) {}
@@ -239,7 +244,8 @@ class BlockCache {
         return p;
       }
     peak_ = std::max(peak_, live_ + bytes);
-    while (!kept_.empty() && live_ + kept_bytes_ + bytes > peak_) give_back_oldest();
+    largest_ = std::max(largest_, bytes);
+    while (!kept_.empty() && live_ + kept_bytes_ + bytes > held_limit()) give_back_oldest();
     void* p;
     try {
       p = raw_allocate(space_, bytes);
@@ -266,6 +272,7 @@ class BlockCache {
     r.kept_bytes = double(kept_bytes_);
     r.live_bytes = double(live_);
     r.peak_bytes = double(peak_);
+    r.held_limit_bytes = double(held_limit());
     return r;
   }
 
@@ -274,6 +281,7 @@ class BlockCache {
     std::size_t bytes;
     void* p;
   };
+  std::size_t held_limit() const { return peak_ + std::max(largest_, peak_ / 16); }
   void give_back_oldest() noexcept {
     raw_free(space_, kept_.front().p, kept_.front().bytes);
     kept_bytes_ -= kept_.front().bytes;
@@ -282,7 +290,7 @@ class BlockCache {
   Space space_;
   std::mutex mutex_;
   std::vector<Block> kept_;  // oldest first
-  std::size_t live_ = 0, kept_bytes_ = 0, peak_ = 0;
+  std::size_t live_ = 0, kept_bytes_ = 0, peak_ = 0, largest_ = 0;
   BlockReuse stats_;
 };
 

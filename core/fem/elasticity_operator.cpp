@@ -70,8 +70,8 @@ void ElasticityOperator::set_bottom_block(const std::vector<real>& B) {
   if (!B.empty() && index(B.size()) != 4 * M)
     throw std::invalid_argument("bottom block has " + std::to_string(B.size()) + " entries, expected 4 x " +
                                 std::to_string(M));
-  B_.clear();
-  Bf_.clear();
+  B_ = {};  // (given back first: the new blocks below are the old ones again, BlockCache)
+  Bf_ = {};
   if (B.empty()) return;
   std::vector<real> Bz = B;
   zero_constrained_bottom_block(G, global_faces_, Bz);

@@ -46,7 +46,9 @@ void row_range(const Slab& s, index& first, index& last) {
 GridHierarchy::Link make_link(const Transfer& T, const GridHierarchy::Level& f, const GridHierarchy::Level& c,
                               const Comm& comm) {
   GridHierarchy::Link k;
-  k.whole = k.restrict_t = k.prolong_t = T;
+  k.restrict_t = k.prolong_t = T;
+  k.whole = T;
+  k.whole.move_to(Space::host);
   if (!f.distributed) return k;  // both whole
   const Interp1D& Y = T.axis[1];
   index f0, f1, c0, c1;

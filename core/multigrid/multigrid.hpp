@@ -98,7 +98,8 @@ struct GridHierarchy {
   };
   // from level l to l + 1
   struct Link {
-    Transfer whole;                 // between the whole grids
+    Transfer whole;                 // between the whole grids, on the host (each Newton
+                                    // step's P^T B; on the device it cost a copy there and back)
     Transfer restrict_t, prolong_t; // the rows this rank computes (whole: `whole`)
     // rows that other ranks own: the fine rows the coarse rows restrict from,
     // the coarse rows the fine rows interpolate from (null: none needed)

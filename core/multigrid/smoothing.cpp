@@ -38,9 +38,7 @@ real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const
   return 1.15 * std::max(es.eigenvalues().maxCoeff(), real(2));
 }
 
-std::vector<real> project_bottom_block(const Transfer& td, const std::vector<real>& Bf) {
-  Transfer t = td;  // (its 1D lists: small)
-  t.move_to(Space::host);
+std::vector<real> project_bottom_block(const Transfer& t, const std::vector<real>& Bf) {
   const GridDims &fg = t.fine, &cg = t.coarse;
   const index Mf = fg.nx() * fg.ny(), Mc = cg.nx() * cg.ny();
   const Interp1D &X = t.axis[0], &Y = t.axis[1];

@@ -74,7 +74,7 @@ real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const
                   Field<real> r, const Reduction* reduce = nullptr);
 
 // the coarse bottom block P^T B of the fine one (4 fields of nx*ny each;
-// host data, t wherever it lives)
+// host data, t's lists on the host: GridHierarchy::Link::whole)
 std::vector<real> project_bottom_block(const Transfer& t, const std::vector<real>& fine);
 
 }  // namespace tresca
