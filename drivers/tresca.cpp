@@ -389,7 +389,7 @@ void print_header(const Command& c, const ThreadPlacement& placement, const Comm
               comm.distributed() ? (" per rank x " + std::to_string(comm.size()) + " MPI ranks (" + run_rank_layout(spec) + ")")
                                      .c_str() : "");
   std::printf("        estimated peak memory %.2f GB%s; kernels: %s; %s\n",
-              estimated_memory_bytes_per_rank(spec, split_over(grid_of(spec), comm).size()) / 1e9,
+              run_memory_per_rank(spec) / 1e9,
               comm.distributed() ? " per rank" : "",
               build_info().c_str(), omp_wait_setting().c_str());
   std::printf("        %s; %s; kernels on %s\n", placement.describe().c_str(), huge_page_setting().c_str(),

@@ -261,6 +261,10 @@ std::string run_rank_layout(const ProblemSpec& spec) {
   return rank_layout(grid_of(spec), Comm::world(), "each rank solves the whole mesh");
 }
 
+double run_memory_per_rank(const ProblemSpec& spec) {
+  return estimated_memory_bytes_per_rank(spec, split_over(grid_of(spec), Comm::world()).size());
+}
+
 RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   RunResult R;
   R.friction = opt.friction;

@@ -140,5 +140,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt);
 // how run_tresca's ranks hold the mesh of spec (multigrid.hpp: rank_layout;
 // a mesh too small to split is solved whole by every rank)
 std::string run_rank_layout(const ProblemSpec& spec);
+// the memory estimate of one of run_tresca's ranks (problem.hpp), with the
+// mesh split as it will be
+double run_memory_per_rank(const ProblemSpec& spec);
 
 }  // namespace tresca

@@ -1,6 +1,6 @@
 #include "core/io/cli.hpp"
 
-#include "core/multigrid/multigrid.hpp"
+#include "core/contact/run.hpp"
 #include "core/parallel/comm.hpp"
 #include "kernels/launch.hpp"
 #include "kernels/isa.hpp"
@@ -206,8 +206,7 @@ void check_memory(const ProblemSpec& s) {
   // short of it fails the check on every rank (the same message, no hang)
   const Comm& comm = Comm::world();
   const int on_host = comm.ranks_on_this_host();
-  const double per_rank = estimated_memory_bytes_per_rank(s, split_over(grid_of(s), comm).size()),
-               need = per_rank * on_host;
+  const double per_rank = run_memory_per_rank(s), need = per_rank * on_host;
   const auto [have, whose] = memory_limit();
   const bool short_here = have > 0 && need > 0.9 * have;
   if (comm.max(short_here ? 1.0 : 0.0) > 0) {

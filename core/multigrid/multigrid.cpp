@@ -111,7 +111,8 @@ const Comm& split_over(const GridDims& g, const Comm& comm) {
 std::string rank_layout(const GridDims& g, const Comm& comm, const std::string& whole) {
   if (!comm.distributed()) return "one rank";
   if (worth_distributing(g, comm)) return "y-slabs";
-  return whole + ": too small to split, under 2 node rows in y or 2048 nodes a rank";
+  return whole + ": too small to split, under 2 node rows in y or " + std::to_string(kMinNodesPerRank) +
+         " nodes a rank";
 }
 
 std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, index coarse_nodes, const Comm& comm,

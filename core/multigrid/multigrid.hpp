@@ -79,7 +79,8 @@ struct MGOptions {
 
 // whether a grid is split over the ranks of comm: more than one rank, at
 // least 2 node rows and min_nodes_per_rank nodes per rank
-bool worth_distributing(const GridDims& g, const Comm& comm, index min_nodes_per_rank = 2048);
+constexpr index kMinNodesPerRank = 2048;
+bool worth_distributing(const GridDims& g, const Comm& comm, index min_nodes_per_rank = kMinNodesPerRank);
 // the ranks a fine grid's operators are split over: comm where
 // worth_distributing, else Comm::self() (every rank holds the grid whole)
 const Comm& split_over(const GridDims& g, const Comm& comm);
@@ -116,7 +117,7 @@ struct GridHierarchy {
   // semi-coarsening until a grid has at most coarse_nodes nodes; levels
   // split over comm's ranks where worth_distributing (Comm::self(): all whole)
   static std::shared_ptr<const GridHierarchy> build(const GridDims& fine, index coarse_nodes,
-                                                    const Comm& comm = Comm::self(), index min_nodes_per_rank = 2048);
+                                                    const Comm& comm = Comm::self(), index min_nodes_per_rank = kMinNodesPerRank);
 };
 
 // The description of the operator a multigrid preconditions: its
