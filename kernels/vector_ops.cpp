@@ -104,6 +104,16 @@ void convert(index n, const From* x, To* y) {
   for_each_entry(n, Cost{double(sizeof(From) + sizeof(To)), 0}, [=](index i) { y[i] = To(x[i]); });
 }
 
+template <class To, class From>
+void scatter_to(index n, const index* at, const From* x, To* y) {
+  for_each_entry(n, Cost{double(sizeof(index) + sizeof(From) + 2 * sizeof(To)), 0}, [=](index k) { y[at[k]] = To(x[k]); });
+}
+
+template <class To, class From>
+void gather_from(index n, const index* at, const From* x, To* y) {
+  for_each_entry(n, Cost{double(sizeof(index) + sizeof(From) + 2 * sizeof(To)), 0}, [=](index k) { y[k] = To(x[at[k]]); });
+}
+
 template <class To>
 void reciprocal_or_zero(index n, const real* x, To* y) {
   for_each_entry(n, Cost{double(sizeof(real) + sizeof(To)), 1}, [=](index i) { y[i] = x[i] != 0 ? To(1 / x[i]) : To(0); });
@@ -134,6 +144,10 @@ template void reciprocal_or_zero<double>(index, const real*, double*);
 template void reciprocal_or_zero<float>(index, const real*, float*);
 template void convert<float, double>(index, const double*, float*);
 template void convert<double, float>(index, const float*, double*);
+template void scatter_to<double, double>(index, const index*, const double*, double*);
+template void scatter_to<float, double>(index, const index*, const double*, float*);
+template void gather_from<double, double>(index, const index*, const double*, double*);
+template void gather_from<double, float>(index, const index*, const float*, double*);
 template void cheb_update<double>(index, double, double, const double*, const double*, double*, double*);
 template void cheb_update<float>(index, float, float, const float*, const float*, float*, float*);
 template void cheb_first<double>(index, double, const double*, const double*, double*, double*, bool);

@@ -33,6 +33,13 @@ template <class To, class From>
 void convert(index n, const From* x, To* y);               // y = To(x) (double <-> float)
 void scale(index n, real a, real* y);                      // y *= a
 void hadamard(index n, const real* d, const real* x, real* y);  // y = d .* x
+// a short vector's entries placed into, and taken from, entries of a long
+// one: y[at[k]] = To(x[k]) (scatter_to), y[k] = To(x[at[k]]) (gather_from),
+// k < n (To, From: double, float)
+template <class To, class From>
+void scatter_to(index n, const index* at, const From* x, To* y);
+template <class To, class From>
+void gather_from(index n, const index* at, const From* x, To* y);
 // y = 1 / x where x != 0, else 0 (Jacobi's inverse diagonal; To = double, float)
 template <class To>
 void reciprocal_or_zero(index n, const real* x, To* y);

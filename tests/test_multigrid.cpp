@@ -179,6 +179,79 @@ TEST(MultigridCG, HierarchyIsSharedAndTheOperatorComesFromItsDescription) {
                std::invalid_argument);
 }
 
+TEST(MultigridVCycle, OneBuiltLikeAnotherSharesItsWorkVectorsAndLeavesItsAnswersAlone) {
+  // the Newton step's K + B preconditioner is built like the K_ii solver's
+  // multigrid: it shares the V-cycle's work vectors (x, b, r, d on every
+  // level) instead of making its own, and the two V-cycles, in turn, give
+  // bit for bit what each gives alone
+  const Problem P = make_problem(spec_for_dims(64, 32, 32));  // level-0 vectors of 2.4 MiB (float): counted blocks
+  for (Precision prec : {Precision::single_precision, Precision::double_precision}) {
+    MGOptions mo;
+    mo.precision = prec;
+    mo.coarse_nodes = 400;
+    const auto grids = GridHierarchy::build(P.grid, mo.coarse_nodes);
+    Multigrid a(grids, elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mo);
+    const double before = block_reuse(Space::host).live_bytes;
+    Multigrid b(grids, elasticity_on(kFaceX0, P.spec.E, P.spec.nu), mo, &a);
+    const double grown = block_reuse(Space::host).live_bytes - before;
+    // b's own level-0 vectors: dinv alone (made in place of 5 with x, b, r, d)
+    const double vector = double(P.dofs()) * (prec == Precision::single_precision ? 4 : 8);
+    EXPECT_LT(grown, 1.5 * vector) << to_string(prec);
+    const index M = P.grid.nx() * P.grid.ny();
+    std::vector<real> B(4 * M, 0.0);
+    for (index n = 0; n < M; ++n) B[n] = B[2 * M + n] = B[3 * M + n] = 1e9;
+    b.set_bottom_block(B);
+
+    auto ra = test::random_vector(P.dofs(), 51), rb = test::random_vector(P.dofs(), 52);
+    zero_constrained(P.grid, P.interior_faces, ra.data());
+    zero_constrained(P.grid, kFaceX0, rb.data());
+    std::vector<real> za(P.dofs()), zb(P.dofs()), za2(P.dofs()), zb2(P.dofs());
+    a.apply(ra.data(), za.data());
+    b.apply(rb.data(), zb.data());
+    a.apply(ra.data(), za2.data());
+    b.apply(rb.data(), zb2.data());
+    EXPECT_EQ(za, za2) << to_string(prec);
+    EXPECT_EQ(zb, zb2) << to_string(prec);
+    EXPECT_GT(test::max_abs(za), 0);
+    EXPECT_GT(test::max_abs_diff(za, zb), 1e-3 * test::max_abs(za)) << "two operators, two answers";
+  }
+}
+
+TEST(MultigridVCycle, RestrictedToSomeEntriesItIsTheFullVCycleScatteredAndGathered) {
+  // apply_at(at, r, z) = E^T M E r, E placing r at the entries `at`: the
+  // same numbers as the full V-cycle of the scattered vector, gathered,
+  // bit for bit, and in turn with the full apply (they share work vectors)
+  const Problem P = make_problem(spec_for_dims(19, 9, 11));
+  const index nx = P.grid.nx(), N = P.grid.nodes();
+  std::vector<index> at_host;  // the bottom face's nodes off x = 0, 3 components
+  for (int a = 0; a < 3; ++a)
+    for (index iy = 0; iy < P.grid.ny(); ++iy)
+      for (index ix = 1; ix < nx; ++ix) at_host.push_back(a * N + P.grid.node(ix, iy, 0));
+  const index m = index(at_host.size());
+  Field<index> at(at_host.begin(), at_host.end());
+  at.move_to(launch_space());
+  for (Precision prec : {Precision::single_precision, Precision::double_precision}) {
+    MGOptions mo;
+    mo.precision = prec;
+    mo.coarse_nodes = 100;
+    Multigrid mg(P.grid, kFaceX0, P.spec.E, P.spec.nu, mo);
+    const auto r = test::random_vector(m, 61);
+    std::vector<real> full(P.dofs(), 0.0), full_out(P.dofs()), z(m), z_full(m);
+    for (index k = 0; k < m; ++k) full[at_host[k]] = r[k];
+    mg.apply(full.data(), full_out.data());
+    for (index k = 0; k < m; ++k) z_full[k] = full_out[at_host[k]];
+    mg.apply_at(at, r.data(), z.data());
+    EXPECT_EQ(z, z_full) << to_string(prec);
+    EXPECT_GT(test::max_abs(z), 0);
+    // a full apply of another vector in between leaves apply_at's answer alone
+    const auto other = test::random_vector(P.dofs(), 62);
+    mg.apply(other.data(), full_out.data());
+    std::vector<real> z2(m);
+    mg.apply_at(at, r.data(), z2.data());
+    EXPECT_EQ(z, z2) << to_string(prec);
+  }
+}
+
 TEST(MultigridCG, IterationCountIsMeshIndependent) {
   // coarse_nodes = 100 makes every one of these a genuine multilevel cycle
   int its[3];

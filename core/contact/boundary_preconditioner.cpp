@@ -19,8 +19,6 @@ BoundaryPreconditioner::BoundaryPreconditioner(const SteklovPoincare& S, const M
   // the K_ii solver's grids, transfers and smoother bounds
   mg_ = std::make_unique<Multigrid>(S.interior_multigrid().hierarchy(),
                                     elasticity_on(P.dirichlet_faces, P.spec.E, P.spec.nu), mg, &S.interior_multigrid());
-  full_in_.assign(S.full_size(), 0);
-  full_out_.assign(S.full_size(), 0);
 }
 
 void BoundaryPreconditioner::update(const Field<real>& h_placed, const Field<std::uint8_t>& fixed_placed,
@@ -49,11 +47,7 @@ void BoundaryPreconditioner::update(const Field<real>& h_placed, const Field<std
 }
 
 void BoundaryPreconditioner::apply(const real* r, real* z) const {
-  // full_in_ is zero off the contact nodes (set once; the scatter writes only
-  // contact nodes and the V-cycle never writes its right-hand side)
-  S_.scatter(r, full_in_.data());
-  mg_->apply(full_in_.data(), full_out_.data());
-  S_.gather(full_out_.data(), z);
+  mg_->apply_at(S_.contact_rows(), r, z);
   const std::uint8_t* free = free_.data();
   for_each_entry(size(), Cost{9, 0}, [=](index i) {
     if (!free[i]) z[i] = 0;

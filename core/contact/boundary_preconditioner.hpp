@@ -50,7 +50,6 @@ class BoundaryPreconditioner : public LinearOperator {
   std::unique_ptr<Multigrid> mg_;  // K + B
   std::vector<real> kdiag_;  // diag of K at this rank's contact nodes (3 blocks)
   Field<std::uint8_t> free_;
-  mutable Field<real> full_in_, full_out_;
 };
 
 }  // namespace tresca

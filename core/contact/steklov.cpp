@@ -26,6 +26,16 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
     displs_[q] = int(ex * s.y_begin);
   }
   const index n = full_size();
+  // contact node c = c_begin_ + k is ix = 1 + c % ex, row c / ex - row0, iz = 0
+  rows_ = Field<index>(std::size_t(3 * p_));
+  {
+    const index N = box().nodes(), nx = box().nx(), row0 = slab().y_begin - slab().lo, c0 = c_begin_, p = p_;
+    index* rows = rows_.data();
+    for_each_entry(p, Cost{24, 0}, [=](index k) {
+      const index c = c0 + k, node = 1 + c % ex + nx * (c / ex - row0);
+      for (int a = 0; a < 3; ++a) rows[a * p + k] = a * N + node;
+    });
+  }
   // the load on this rank's rows (all of it on one rank): its contact part
   // and its interior part, made once where the launches run
   interior_load_ = local_rows(slab(), P.load.data());
@@ -40,25 +50,9 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
 
 SteklovPoincare::~SteklovPoincare() = default;
 
-// the contact face's nodes in a 3D vector of box g: node c (this rank's
-// c - c_begin) is ix = 1 + c % ex, row c / ex - row0, iz = 0
-void SteklovPoincare::scatter(const real* vc, real* full) const {
-  const index N = box().nodes(), nx = box().nx(), ex = P_.grid.ex, row0 = slab().y_begin - slab().lo, c0 = c_begin_,
-              p = p_;
-  for_each_entry(p, Cost{48, 0}, [=](index k) {
-    const index c = c0 + k, n = 1 + c % ex + nx * (c / ex - row0);
-    for (int a = 0; a < 3; ++a) full[a * N + n] = vc[a * p + k];
-  });
-}
+void SteklovPoincare::scatter(const real* vc, real* full) const { scatter_to(3 * p_, rows_.data(), vc, full); }
 
-void SteklovPoincare::gather(const real* full, real* vc) const {
-  const index N = box().nodes(), nx = box().nx(), ex = P_.grid.ex, row0 = slab().y_begin - slab().lo, c0 = c_begin_,
-              p = p_;
-  for_each_entry(p, Cost{48, 0}, [=](index k) {
-    const index c = c0 + k, n = 1 + c % ex + nx * (c / ex - row0);
-    for (int a = 0; a < 3; ++a) vc[a * p + k] = full[a * N + n];
-  });
-}
+void SteklovPoincare::gather(const real* full, real* vc) const { gather_from(3 * p_, rows_.data(), full, vc); }
 
 real SteklovPoincare::sum(real local) const { return comm_.sum(local); }
 real SteklovPoincare::max(real local) const { return real(comm_.max(local)); }

@@ -102,12 +102,15 @@ class SteklovPoincare {
   double apply_work(long long inner_iterations) const;
   const Problem& problem() const { return P_; }
 
-  // scatter contact values into / gather them from a full SoA grid vector
-  // (this rank's contact nodes and rows)
-  void scatter(const real* vc, real* full) const;
-  void gather(const real* full, real* vc) const;
+  // where this rank's contact values lie in a full SoA grid vector: its 3p
+  // contact dofs (component a of node c - first_contact_node() at a p + c)
+  // are the entries contact_rows()[a p + c] (where the launches run)
+  const Field<index>& contact_rows() const { return rows_; }
 
  private:
+  // scatter contact values into / gather them from a full SoA grid vector
+  void scatter(const real* vc, real* full) const;
+  void gather(const real* full, real* vc) const;
   SolveStats solve_interior(const real* rhs, real* z, real rtol, const real* guess = nullptr) const;
   // out = (K x)_c for x = v on the contact face and z inside, where
   // K_ii z = −K_ic v, or with li (the interior load, 3D, overwritten)
@@ -128,6 +131,7 @@ class SteklovPoincare {
   index c_begin_ = 0, c_end_ = 0;  // this rank's contact nodes
   std::vector<int> counts_, displs_;           // every rank's contact nodes (whole())
   mutable CGWorkspace ws_;  // scratch
+  Field<index> rows_;                         // contact_rows()
   Field<real> interior_load_, contact_load_;  // l_i (K_ii's rows: 3D) and l_c (3p), this rank's
   mutable Field<real> w_, t_, z_, load_;     // load_: residual()'s right-hand side
 };

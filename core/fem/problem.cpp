@@ -190,11 +190,12 @@ Problem make_problem(const ProblemSpec& spec) {
 double estimated_memory_bytes(const ProblemSpec& s) {
   const double n = double(s.nodes());
   // fine-grid vectors of 3n doubles: load 1, Steklov buffers 5, inner CG 4,
-  // two multigrid hierarchies 2 x (r, d, dinv) + coarse copies, boundary
-  // preconditioner 2, Newton's body and the step's extensions 4, set-up
-  // temporaries; 23 x (1 + 1/7) of them, coarse levels included, bound the
-  // measured peak (perf/RESULTS.md §0i)
-  return 23.0 * 3 * n * 8 * (1 + 1.0 / 7);
+  // the V-cycle's work vectors (float: b, x, r, d; shared by the two
+  // multigrids) and each multigrid's dinv, Newton's body and the step's
+  // extensions 4, set-up temporaries; 19 x (1 + 1/7) of them, coarse levels
+  // included, and 64 MB for the program bound the measured peak (20.5
+  // vectors at level 12, 20.1 at level 13; perf/RESULTS.md §0u)
+  return 19.0 * 3 * n * 8 * (1 + 1.0 / 7) + 64e6;
 }
 
 double estimated_memory_bytes_per_rank(const ProblemSpec& s, int ranks) {

@@ -185,48 +185,69 @@ Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscret
   }
   factor_coarse();
   if (opt_.precision == Precision::single_precision)
-    build_work<float>();
+    build_work<float>(like);
   else
-    build_work<double>();
+    build_work<double>(like);
 }
 
 template <>
-std::vector<Multigrid::Work<double>>& Multigrid::work<double>() {
+std::shared_ptr<Multigrid::Cycle<double>>& Multigrid::cycle<double>() {
   return work_d_;
 }
 template <>
-std::vector<Multigrid::Work<float>>& Multigrid::work<float>() {
+std::shared_ptr<Multigrid::Cycle<float>>& Multigrid::cycle<float>() {
   return work_s_;
 }
 template <>
-const std::vector<Multigrid::Work<double>>& Multigrid::work<double>() const {
+const std::shared_ptr<Multigrid::Cycle<double>>& Multigrid::cycle<double>() const {
   return work_d_;
 }
 template <>
-const std::vector<Multigrid::Work<float>>& Multigrid::work<float>() const {
+const std::shared_ptr<Multigrid::Cycle<float>>& Multigrid::cycle<float>() const {
   return work_s_;
+}
+template <>
+std::vector<Field<double>>& Multigrid::dinv<double>() {
+  return dinv_d_;
+}
+template <>
+std::vector<Field<float>>& Multigrid::dinv<float>() {
+  return dinv_s_;
+}
+template <>
+const std::vector<Field<double>>& Multigrid::dinv<double>() const {
+  return dinv_d_;
+}
+template <>
+const std::vector<Field<float>>& Multigrid::dinv<float>() const {
+  return dinv_s_;
 }
 
 template <class T>
-void Multigrid::build_work() {
-  std::vector<Work<T>>& W = work<T>();
-  W.resize(levels_.size());
-  for (size_t l = 0; l < levels_.size(); ++l) {
-    Work<T>& w = W[l];
-    const index n = levels_[l].A.size();
-    w.r.resize(n);
-    w.d.resize(n);
-    // a double level 0 solves in the caller's arrays (apply sets xp, bp)
-    if (l > 0 || !std::is_same<T, real>::value) {
-      w.x.resize(n);
-      w.b.resize(n);
-      w.xp = w.x.data();
-      w.bp = w.b.data();
-    }
-    if (l + 1 < levels_.size()) {
-      const GridHierarchy::Link& k = grids_->to_coarse[l];
-      if (k.fetch_fine) w.fine_rows.resize(k.fetch_fine->size());
-      if (k.fetch_coarse) w.coarse_rows.resize(k.fetch_coarse->size());
+void Multigrid::build_work(const Multigrid* like) {
+  std::shared_ptr<Cycle<T>>& C = cycle<T>();
+  if (like && like->cycle<T>()) {
+    C = like->cycle<T>();  // (the same hierarchy, so the same sizes)
+  } else {
+    C = std::make_shared<Cycle<T>>();
+    C->levels.resize(levels_.size());
+    for (size_t l = 0; l < levels_.size(); ++l) {
+      Work<T>& w = C->levels[l];
+      const index n = levels_[l].A.size();
+      w.r.resize(n);
+      w.d.resize(n);
+      // a double level 0 solves in the caller's arrays (apply sets xp, bp)
+      if (l > 0 || !std::is_same<T, real>::value) {
+        w.x.resize(n);
+        w.b.resize(n);
+        w.xp = w.x.data();
+        w.bp = w.b.data();
+      }
+      if (l + 1 < levels_.size()) {
+        const GridHierarchy::Link& k = grids_->to_coarse[l];
+        if (k.fetch_fine) w.fine_rows.resize(k.fetch_fine->size());
+        if (k.fetch_coarse) w.coarse_rows.resize(k.fetch_coarse->size());
+      }
     }
   }
   refresh_work<T>();
@@ -234,11 +255,12 @@ void Multigrid::build_work() {
 
 template <class T>
 void Multigrid::refresh_work() {
-  std::vector<Work<T>>& W = work<T>();
+  std::vector<Field<T>>& D = dinv<T>();
+  D.resize(levels_.size());
   for (size_t l = 0; l < levels_.size(); ++l) {
     const Field<real> d = levels_[l].A.diagonal();
-    W[l].dinv.resize(d.size());
-    reciprocal_or_zero<T>(index(d.size()), d.data(), W[l].dinv.data());  // ghost rows: 0
+    D[l].resize(d.size());
+    reciprocal_or_zero<T>(index(d.size()), d.data(), D[l].data());  // ghost rows: 0
   }
 }
 
@@ -333,15 +355,16 @@ void Multigrid::residual(int l, const T* b, T* x, T* r) const {
 
 template <class T>
 void Multigrid::smooth(int l, bool zero_guess, const T* in) const {
-  const Work<T>& w = work<T>()[l];
+  Work<T>& w = work<T>()[l];
+  const T* dinv_l = dinv<T>()[l].data();
   ScopedTimer t(Kernel::smoother);
   const ElasticityOperator& A = levels_[l].A;
   chebyshev_smooth<T>(
-      A.size(), levels_[l].lmax, opt_.range, opt_.degree, zero_guess, w.dinv.data(), w.bp, w.xp, w.r.data(), w.d.data(),
+      A.size(), levels_[l].lmax, opt_.range, opt_.degree, zero_guess, dinv_l, w.bp, w.xp, w.r.data(), w.d.data(),
       [&](T* x, T* r) { residual<T>(l, w.bp, x, r); },
       [&](T* x, T* y, T s, T t) {
         A.update_ghosts(x);
-        A.chebyshev_step(w.bp, x, y, w.dinv.data(), w.d.data(), s, t);
+        A.chebyshev_step(w.bp, x, y, dinv_l, w.d.data(), s, t);
       },
       in);
 }
@@ -349,8 +372,8 @@ void Multigrid::smooth(int l, bool zero_guess, const T* in) const {
 template <class T>
 void Multigrid::restrict_residual(int l) const {
   // b_c = P^T r (the fine rows other ranks own fetched first)
-  const Work<T>& w = work<T>()[l];
-  const Work<T>& cw = work<T>()[l + 1];
+  Work<T>& w = work<T>()[l];
+  Work<T>& cw = work<T>()[l + 1];
   const GridHierarchy::Link& k = grids_->to_coarse[l];
   const ElasticityOperator& C = levels_[l + 1].A;
   ScopedTimer t(Kernel::restrict_, double(w.r.size()) * in_precision<T>(kRestrictCost));
@@ -371,8 +394,8 @@ T* Multigrid::prolongate_correction(int l) const {
   // the post-smoother's steps all fuse (smoothing.hpp: x itself or r); the
   // correction vanishes on constrained faces (they are interpolated from
   // constrained coarse nodes only), the mask makes it exact
-  const Work<T>& w = work<T>()[l];
-  const Work<T>& cw = work<T>()[l + 1];
+  Work<T>& w = work<T>()[l];
+  Work<T>& cw = work<T>()[l + 1];
   const GridHierarchy::Link& k = grids_->to_coarse[l];
   const ElasticityOperator& A = levels_[l].A;
   ScopedTimer t(Kernel::prolongate, double(w.r.size()) * in_precision<T>(kProlongateCost));
@@ -389,7 +412,7 @@ T* Multigrid::prolongate_correction(int l) const {
 
 template <class T>
 void Multigrid::vcycle(int l) const {
-  const Work<T>& w = work<T>()[l];
+  Work<T>& w = work<T>()[l];
   const index n = levels_[l].A.size();
   if (l + 1 == num_levels()) {  // on rank 0 (every rank if all levels are whole)
     // on the host: the right-hand side there and the solution back (a
@@ -408,7 +431,7 @@ void Multigrid::vcycle(int l) const {
   restrict_residual<T>(l);
   if (grids_->agglomerated(l + 1)) {
     // the coarse levels on rank 0 alone; their correction to every rank
-    const Work<T>& cw = work<T>()[l + 1];
+    Work<T>& cw = work<T>()[l + 1];
     if (comm().rank() == 0) vcycle<T>(l + 1);
     comm().broadcast(cw.x.data(), int(cw.x.size()));
   } else {
@@ -417,26 +440,82 @@ void Multigrid::vcycle(int l) const {
   smooth<T>(l, false, prolongate_correction<T>(l));
 }
 
-void Multigrid::apply(const real* r, real* z) const {
-  const index n = size();
+namespace {
+// marks a V-cycle's work vectors in use for its span; one V-cycle inside
+// another in the same vectors (multigrids that share them) is a defect
+class InUse {
+ public:
+  template <class C>
+  explicit InUse(C& c) : busy_(c.busy) {
+    if (busy_) throw std::logic_error("multigrid: a V-cycle inside another one that shares its work vectors");
+    busy_ = true;
+  }
+  ~InUse() { busy_ = false; }
+  InUse(const InUse&) = delete;
+  InUse& operator=(const InUse&) = delete;
+
+ private:
+  bool& busy_;
+};
+}  // namespace
+
+void Multigrid::check_launch_space() const {
   if (levels_[0].A.stencil().groups.space() != launch_space())
     throw std::logic_error(std::string("multigrid: built with launches on the ") +
                            to_string(levels_[0].A.stencil().groups.space()) + ", applied with them on the " +
                            to_string(launch_space()));
+}
+
+void Multigrid::apply(const real* r, real* z) const {
+  check_launch_space();
+  const index n = size();
   // every level whole on several ranks: rank 0 alone, the answer to all
   const bool alone = grids_->agglomerated(0), run = !alone || comm().rank() == 0;
   if (opt_.precision == Precision::double_precision) {
-    work_d_[0].bp = r;
-    work_d_[0].xp = z;
+    const InUse busy(*work_d_);
+    Work<double>& w = work<double>()[0];
+    w.bp = r;
+    w.xp = z;
     if (run) vcycle<double>(0);
   } else {
-    const Work<float>& w = work_s_[0];
+    const InUse busy(*work_s_);
+    Work<float>& w = work<float>()[0];
     convert<float>(n, r, w.b.data());
     if (run) vcycle<float>(0);
     convert<double>(n, w.x.data(), z);
   }
   if (alone) comm().broadcast(z, int(n));
   levels_[0].A.zero_ghosts(z);
+}
+
+template <class T>
+void Multigrid::vcycle_at(const Field<index>& at, const real* r, real* z) const {
+  const InUse busy(*cycle<T>());
+  Work<T>& w = work<T>()[0];
+  const index n = size(), m = index(at.size());
+  if (index(w.x.size()) != n) {  // (a double level 0 otherwise solves in the caller's arrays)
+    w.x.resize(n);
+    w.b.resize(n);
+  }
+  w.xp = w.x.data();
+  w.bp = w.b.data();
+  fill<T>(n, 0, w.b.data());
+  scatter_to(m, at.data(), r, w.b.data());
+  const bool alone = grids_->agglomerated(0);
+  if (!alone || comm().rank() == 0) vcycle<T>(0);
+  if (alone) comm().broadcast(w.x.data(), int(n));
+  gather_from(m, at.data(), w.x.data(), z);
+}
+
+void Multigrid::apply_at(const Field<index>& at, const real* r, real* z) const {
+  check_launch_space();
+  if (!at.empty() && at.space() != launch_space())
+    throw std::logic_error(std::string("multigrid: apply_at's entries on the ") + to_string(at.space()) +
+                           ", the launches on the " + to_string(launch_space()));
+  if (opt_.precision == Precision::double_precision)
+    vcycle_at<double>(at, r, z);
+  else
+    vcycle_at<float>(at, r, z);
 }
 
 double Multigrid::cycle_work() const {

@@ -134,7 +134,9 @@ class Multigrid : public LinearOperator {
   // hierarchy must be `grids`) instead of estimating them, for an operator
   // whose Jacobi-scaled spectrum is the same up to boundary terms (the K + B
   // preconditioner of the Newton step against the K_ii solver, well inside
-  // the smoother's safety margin; perf/RESULTS.md §0i)
+  // the smoother's safety margin; perf/RESULTS.md §0i), and share its
+  // V-cycle's work vectors (in the same precision): one V-cycle of either
+  // may not run inside the other's
   Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt = {},
             const Multigrid* like = nullptr);
   // builds its own hierarchy (opt.coarse_nodes) for elasticity on `fine`
@@ -143,6 +145,12 @@ class Multigrid : public LinearOperator {
   // on level-0 vectors: this rank's slab (the whole grid on one rank)
   index size() const override { return levels_[0].A.size(); }
   void apply(const real* r, real* z) const override;
+  // The V-cycle restricted to some level-0 entries, E^T M E: its
+  // right-hand side is r[k] at entry at[k] and zero elsewhere, and z[k] its
+  // result at entry at[k] (k < at.size(); `at` where the launches run, rows
+  // this rank owns). No full-size vector of the caller's: the level-0 work
+  // vectors (made on first use in double precision) hold both.
+  void apply_at(const Field<index>& at, const real* r, real* z) const;
 
   int num_levels() const { return int(levels_.size()); }
   const MGOptions& options() const { return opt_; }
@@ -169,20 +177,32 @@ class Multigrid : public LinearOperator {
     ElasticityOperator A;  // double: lmax estimate, coarse factorisation, op()
     real lmax = 0;
   };
-  // The V-cycle's vectors of one level in precision T.
+  // The V-cycle's vectors of one level in precision T: the scratch of one
+  // V-cycle, which the multigrids of one hierarchy built `like` one another
+  // share (their V-cycles never overlap: apply checks it)
   template <class T>
   struct Work {
-    Field<T> dinv;  // 1 / diag(K + B), 0 on ghost rows
-    mutable Field<T> x, b, r, d, fine_rows, coarse_rows;
-    mutable T* xp = nullptr;  // iterate and right-hand side in use: the
-    mutable const T* bp = nullptr;  // caller's arrays on a double level 0
+    Field<T> x, b, r, d, fine_rows, coarse_rows;
+    T* xp = nullptr;        // iterate and right-hand side in use: the
+    const T* bp = nullptr;  // caller's arrays on a double level 0
   };
   template <class T>
-  std::vector<Work<T>>& work();
+  struct Cycle {
+    std::vector<Work<T>> levels;
+    bool busy = false;  // a V-cycle is running in these vectors
+  };
   template <class T>
-  const std::vector<Work<T>>& work() const;
+  std::shared_ptr<Cycle<T>>& cycle();
   template <class T>
-  void build_work();
+  const std::shared_ptr<Cycle<T>>& cycle() const;
+  template <class T>
+  std::vector<Work<T>>& work() const { return cycle<T>()->levels; }  // (scratch: written by const applies)
+  template <class T>
+  std::vector<Field<T>>& dinv();  // per level: 1 / diag(K + B), 0 on ghost rows
+  template <class T>
+  const std::vector<Field<T>>& dinv() const;
+  template <class T>
+  void build_work(const Multigrid* like);
   template <class T>
   void refresh_work();  // dinv from the levels' operators
   template <class T>
@@ -192,9 +212,12 @@ class Multigrid : public LinearOperator {
   template <class T>
   void vcycle(int l) const;
   template <class T>
+  void vcycle_at(const Field<index>& at, const real* r, real* z) const;
+  template <class T>
   void restrict_residual(int l) const;
   template <class T>
   T* prolongate_correction(int l) const;  // into the post-smoother's entry; returns it
+  void check_launch_space() const;  // throws std::logic_error: built for one space, applied in the other
   void factor_coarse();
   void estimate_lmax(int l);
   const Comm& comm() const { return *grids_->comm; }
@@ -202,8 +225,10 @@ class Multigrid : public LinearOperator {
   MGOptions opt_;
   std::shared_ptr<const GridHierarchy> grids_;
   std::vector<Level> levels_;
-  std::vector<Work<double>> work_d_;
-  std::vector<Work<float>> work_s_;
+  std::shared_ptr<Cycle<double>> work_d_;
+  std::shared_ptr<Cycle<float>> work_s_;
+  std::vector<Field<double>> dinv_d_;
+  std::vector<Field<float>> dinv_s_;
   Eigen::SimplicialLDLT<SparseMatrix> coarse_;  // on rank 0 (every rank when all levels are whole)
   // the pattern coarse_ was ordered for (its fill-reducing ordering is kept
   // while the pattern stays: each bottom block only refactorises)
