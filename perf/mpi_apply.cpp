@@ -155,8 +155,8 @@ int main(int argc, char** argv) {
                   msg, bytes, model.messages, model.bytes, wait * 1e3);
     }
     // Jacobi-CG on the slab: the same iterations and answer on any rank count
-    std::vector<real> b(n), u(n, 0.0);
-    global_to_local(slab, P.load.data(), b.data());
+    const Field<real> load = load_on(P, slab);
+    std::vector<real> b(load.begin(), load.end()), u(n, 0.0);
     zero_constrained(slab.local, slab.local_faces(P.interior_faces), b.data());
     K.zero_ghosts(b.data());
     const JacobiPreconditioner J(K);

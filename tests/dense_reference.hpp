@@ -42,8 +42,9 @@ inline DenseSchur dense_schur(const Problem& P) {
   d.Kic = Kci.transpose();
   Eigen::VectorXd lc(nc);
   d.li.resize(ni);
-  for (index r = 0; r < nc; ++r) lc[r] = P.load[d.cdof[r]];
-  for (index r = 0; r < ni; ++r) d.li[r] = P.load[d.idof[r]];
+  const Field<real> load = whole_load(P);
+  for (index r = 0; r < nc; ++r) lc[r] = load[d.cdof[r]];
+  for (index r = 0; r < ni; ++r) d.li[r] = load[d.idof[r]];
   Eigen::LDLT<Eigen::MatrixXd> f(d.Kii);
   d.S = Kcc - Kci * f.solve(d.Kic);
   d.b = lc - Kci * f.solve(d.li);

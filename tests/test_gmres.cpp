@@ -83,7 +83,8 @@ TEST(GMRES, SolvesNonSymmetricSystemsLikeDenseLU) {
 TEST(GMRES, MatchesCGOnTheElasticitySystemWithMultigrid) {
   const Problem P = make_problem(spec_for_level(5));
   Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
-  std::vector<real> b(P.load.begin(), P.load.end());
+  const Field<real> load = whole_load(P);
+  std::vector<real> b(load.begin(), load.end());
   zero_constrained(P.grid, P.interior_faces, b.data());
   std::vector<real> xg(P.dofs()), xc(P.dofs());
   GMRESOptions go;

@@ -84,7 +84,8 @@ TEST(MultigridCG, MatchesSparseDirectSolveOnOddMeshes) {
     const Field<real>& u = sol.u;
     ASSERT_TRUE(st.ok()) << to_string(st.reason);
     EXPECT_LT(sol.relative_residual, 1e-11);
-    std::vector<real> b(P.load.begin(), P.load.end());
+    const Field<real> load = whole_load(P);
+  std::vector<real> b(load.begin(), load.end());
     zero_constrained(P.grid, P.interior_faces, b.data());
     EXPECT_LT(st.iterations, 40);
     Eigen::SimplicialLDLT<SparseMatrix> ldlt(assemble(mg.op(0)));
@@ -287,7 +288,8 @@ TEST(MultigridCG, SemiCoarseningKeepsAnisotropicMeshesFast) {
 TEST(CG, ReportsMaxIterationsInsteadOfLooping) {
   const Problem P = make_problem(spec_for_level(4));
   ElasticityOperator A(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
-  std::vector<real> b(P.load.begin(), P.load.end()), u(P.dofs());
+  const Field<real> load = whole_load(P);
+  std::vector<real> b(load.begin(), load.end()), u(P.dofs());
   zero_constrained(P.grid, P.interior_faces, b.data());
   CGOptions o;
   o.rtol = 1e-14;

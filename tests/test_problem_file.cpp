@@ -88,11 +88,22 @@ TEST(ProblemFile, LoadsAreConsistentNodalForces) {
   const Problem P = make_problem(f.spec);
   const index N = P.nodes();
   const real keep = 1 - 0.5 / 4;
-  const real fy = std::accumulate(P.load.begin() + N, P.load.begin() + 2 * N, 0.0);
-  const real fz = std::accumulate(P.load.begin() + 2 * N, P.load.end(), 0.0);
+  const Field<real> load = whole_load(P);
+  const real fy = std::accumulate(load.begin() + N, load.begin() + 2 * N, 0.0);
+  const real fz = std::accumulate(load.begin() + 2 * N, load.end(), 0.0);
   EXPECT_NEAR(fy, 0.5 * 3e6 * 2 * 0.5 * keep, 1e-6);
   EXPECT_NEAR(fz, 0.5 * -8e4 * 2 * 1 * 0.5 * keep, 1e-6);
-  EXPECT_EQ(std::accumulate(P.load.begin(), P.load.begin() + N, 0.0), 0.0);  // no x1 traction: "traction" replaces all
+  EXPECT_EQ(std::accumulate(load.begin(), load.begin() + N, 0.0), 0.0);  // no x1 traction: "traction" replaces all
+  // on the rows of any slab (ghost rows included), the whole mesh's values bit for bit
+  for (int ranks : {2, 3})
+    for (int rank = 0; rank < ranks; ++rank) {
+      const Slab s = make_slab(P.grid, rank, ranks);
+      const Field<real> part = load_on(P, s);
+      ASSERT_EQ(part.size(), std::size_t(3 * s.local.nodes()));
+      std::vector<real> expect(part.size());
+      global_to_local(s, load.data(), expect.data());
+      EXPECT_EQ(std::vector<real>(part.begin(), part.end()), expect) << "rank " << rank << " of " << ranks;
+    }
 }
 
 TEST(ProblemFile, ErrorsNameTheKey) {

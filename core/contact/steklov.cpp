@@ -38,7 +38,7 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
   }
   // the load on this rank's rows (all of it on one rank): its contact part
   // and its interior part, made once where the launches run
-  interior_load_ = local_rows(slab(), P.load.data());
+  interior_load_ = load_on(P, slab());
   contact_load_ = Field<real>(3 * p_);
   gather(interior_load_.data(), contact_load_.data());
   zero_constrained(box(), mg_->op(0).faces(), interior_load_.data());

@@ -148,48 +148,65 @@ GridDims grid_of(const ProblemSpec& spec) {
 }
 
 Problem make_problem(const ProblemSpec& spec) {
-  HostLaunches host;  // the problem's description, the load included, is host data
   validate(spec);
   Problem P;
   P.spec = spec;
   P.grid = grid_of(spec);
-  const GridDims& g = P.grid;
-  const index N = g.nodes();
-  P.load.assign(3 * N, 0.0);
-  // surface tractions: face f's quads, each node of a quad gets area/4
-  const real L = spec.load_scale;
-  auto face = [&](int f, index n1, index n2, real area, auto node) {
-    for (index j = 0; j < n2; ++j)
-      for (index i = 0; i < n1; ++i)
-        for (int k = 0; k < 4; ++k) {
-          const index n = node(i + (k & 1), j + (k >> 1));
-          for (int a = 0; a < 3; ++a) P.load[a * N + n] += L * spec.traction[f][a] * area / 4;
-        }
-  };
-  face(kLoadX1, g.ey, g.ez, g.hy() * g.hz(), [&](index j, index k) { return g.node(g.ex, j, k); });
-  face(kLoadY0, g.ex, g.ez, g.hx() * g.hz(), [&](index i, index k) { return g.node(i, 0, k); });
-  face(kLoadY1, g.ex, g.ez, g.hx() * g.hz(), [&](index i, index k) { return g.node(i, g.ey, k); });
-  face(kLoadZ1, g.ex, g.ey, g.hx() * g.hy(), [&](index i, index j) { return g.node(i, j, g.ez); });
-  // body force: each brick gives volume/8 to each of its 8 nodes
-  if (spec.body_force != std::array<real, 3>{0, 0, 0}) {
-    const real q = g.hx() * g.hy() * g.hz() / 8;
-    for (index ez = 0; ez < g.ez; ++ez)
-      for (index ey = 0; ey < g.ey; ++ey)
-        for (index ex = 0; ex < g.ex; ++ex)
-          for (int k = 0; k < 8; ++k) {
-            const index n = g.node(ex + (k & 1), ey + ((k >> 1) & 1), ez + (k >> 2));
-            for (int a = 0; a < 3; ++a) P.load[a * N + n] += L * spec.body_force[a] * q;
-          }
-  }
-  for (index iz = 0; iz < g.nz(); ++iz)
-    for (index iy = 0; iy < g.ny(); ++iy)
-      for (int a = 0; a < 3; ++a) P.load[a * N + g.node(0, iy, iz)] = 0;
   return P;
 }
 
+Field<real> load_on(const Problem& P, const Slab& s) {
+  HostLaunches host;  // assembled on the host, then moved where the launches run
+  const ProblemSpec& spec = P.spec;
+  const GridDims& g = P.grid;
+  const GridDims& box = s.local;
+  const index N = box.nodes(), first = s.y_begin - s.lo, last = first + box.ny();  // global rows [first, last)
+  Field<real> load(std::size_t(3 * N), 0.0);
+  real* l = load.data();
+  // adds v to node (ix, iy, iz) of the whole grid where the slab holds it:
+  // every node's terms come in the same order whatever the slab, so each
+  // rank's rows hold the whole mesh's values bit for bit
+  auto add = [&](index ix, index iy, index iz, const std::array<real, 3>& v) {
+    if (iy < first || iy >= last) return;
+    const index n = box.node(ix, iy - first, iz);
+    for (int a = 0; a < 3; ++a) l[a * N + n] += v[a];
+  };
+  // surface tractions: face f's quads, each node of a quad gets area/4
+  const real L = spec.load_scale;
+  auto face = [&](int f, index n1, index n2, real area, auto node) {
+    std::array<real, 3> v;
+    for (int a = 0; a < 3; ++a) v[a] = L * spec.traction[f][a] * area / 4;
+    for (index j = 0; j < n2; ++j)
+      for (index i = 0; i < n1; ++i)
+        for (int k = 0; k < 4; ++k) node(i + (k & 1), j + (k >> 1), v);
+  };
+  face(kLoadX1, g.ey, g.ez, g.hy() * g.hz(), [&](index j, index k, const auto& v) { add(g.ex, j, k, v); });
+  face(kLoadY0, g.ex, g.ez, g.hx() * g.hz(), [&](index i, index k, const auto& v) { add(i, 0, k, v); });
+  face(kLoadY1, g.ex, g.ez, g.hx() * g.hz(), [&](index i, index k, const auto& v) { add(i, g.ey, k, v); });
+  face(kLoadZ1, g.ex, g.ey, g.hx() * g.hy(), [&](index i, index j, const auto& v) { add(i, j, g.ez, v); });
+  // body force: each brick gives volume/8 to each of its 8 nodes (the bricks
+  // with a node in the slab's rows)
+  if (spec.body_force != std::array<real, 3>{0, 0, 0}) {
+    const real q = g.hx() * g.hy() * g.hz() / 8;
+    std::array<real, 3> v;
+    for (int a = 0; a < 3; ++a) v[a] = L * spec.body_force[a] * q;
+    for (index ez = 0; ez < g.ez; ++ez)
+      for (index ey = std::max<index>(0, first - 1); ey < std::min(g.ey, last); ++ey)
+        for (index ex = 0; ex < g.ex; ++ex)
+          for (int k = 0; k < 8; ++k) add(ex + (k & 1), ey + ((k >> 1) & 1), ez + (k >> 2), v);
+  }
+  for (index iz = 0; iz < box.nz(); ++iz)
+    for (index iy = 0; iy < box.ny(); ++iy)
+      for (int a = 0; a < 3; ++a) l[a * N + box.node(0, iy, iz)] = 0;
+  load.move_to(host.space_before());
+  return load;
+}
+
+Field<real> whole_load(const Problem& P) { return load_on(P, make_slab(P.grid, 0, 1)); }
+
 double estimated_memory_bytes(const ProblemSpec& s) {
   const double n = double(s.nodes());
-  // fine-grid vectors of 3n doubles: load 1, Steklov buffers 5, inner CG 4,
+  // fine-grid vectors of 3n doubles: Steklov buffers and the load 5, inner CG 4,
   // the V-cycle's work vectors (float: b, x, r, d; shared by the two
   // multigrids) and each multigrid's dinv, Newton's body and the step's
   // extensions 4, set-up temporaries; 19 x (1 + 1/7) of them, coarse levels
@@ -200,7 +217,7 @@ double estimated_memory_bytes(const ProblemSpec& s) {
 
 double estimated_memory_bytes_per_rank(const ProblemSpec& s, int ranks) {
   if (ranks <= 1) return estimated_memory_bytes(s);
-  return estimated_memory_bytes(s) / ranks + 2 * 3 * double(s.nodes()) * 8;
+  return estimated_memory_bytes(s) / ranks + 128e6;
 }
 
 }  // namespace tresca

@@ -19,6 +19,7 @@
 #include "kernels/launch.hpp"
 #include "kernels/grid.hpp"
 #include "kernels/types.hpp"
+#include "core/parallel/slab.hpp"
 
 namespace tresca {
 
@@ -93,7 +94,6 @@ struct Problem {
   GridDims grid;
   unsigned dirichlet_faces = kFaceX0;              // K: u = 0 on x = 0
   unsigned interior_faces = kFaceX0 | kFaceZ0;     // K_ii: also the contact face
-  Field<real> load;                                // l, SoA, 3N (host memory)
   index contact_nodes() const { return spec.contact_nodes(); }
   // grid node of contact node c
   index contact_grid_node(index c) const { return tresca::contact_grid_node(grid, c); }
@@ -104,15 +104,21 @@ struct Problem {
 };
 
 Problem make_problem(const ProblemSpec& spec);
-// the mesh of a problem, without building it (no load vector)
+// The load vector l (SoA, 3 x the slab's box: its ghost rows included) on
+// the rows of slab s, where the launches run: made for the rows asked for,
+// so no rank holds the whole mesh's; every node's value bit for bit the
+// same whatever the slab. whole_load: on the whole grid.
+Field<real> load_on(const Problem& P, const Slab& s);
+Field<real> whole_load(const Problem& P);
+// the mesh of a problem, without building it
 GridDims grid_of(const ProblemSpec& spec);
 
 // Rough peak memory of a full tresca solve in bytes (for a warning before large runs).
 double estimated_memory_bytes(const ProblemSpec& s);
 // ... of one of `ranks` MPI ranks (core/parallel): its share of the
-// distributed fields plus what every rank holds whole (the load and one
-// temporary of 3n doubles); held against the measured peak in
-// perf/RESULTS.md §0g.
+// distributed fields plus 128 MB for what each process holds besides (MPI's
+// buffers, the block cache's slack; no rank holds a field of the whole
+// mesh); held against the measured peak in perf/RESULTS.md §0u.
 double estimated_memory_bytes_per_rank(const ProblemSpec& s, int ranks);
 
 }  // namespace tresca

@@ -16,7 +16,7 @@ InteriorSolution solve_interior_elasticity(const Problem& P, const Multigrid& mg
   auto norm = [&](const real* v) { return std::sqrt(reduce ? reduce->sum(dot(n, v, v)) : dot(n, v, v)); };
   InteriorSolution s;
   s.u.resize(n);
-  Field<real> b = local_rows(K.slab(), P.load.data());
+  Field<real> b = load_on(P, K.slab());
   zero_constrained(K.grid(), K.faces(), b.data());
   K.zero_ghosts(b.data());
   CGOptions o;
