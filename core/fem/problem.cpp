@@ -206,13 +206,13 @@ Field<real> whole_load(const Problem& P) { return load_on(P, make_slab(P.grid, 0
 
 double estimated_memory_bytes(const ProblemSpec& s) {
   const double n = double(s.nodes());
-  // fine-grid vectors of 3n doubles: Steklov buffers and the load 5, inner CG 4,
-  // the V-cycle's work vectors (float: b, x, r, d; shared by the two
+  // fine-grid vectors of 3n doubles: Steklov buffers and the load 5, inner
+  // CG 4, the V-cycle's work vectors (float: b, x, r, d; shared by the two
   // multigrids) and each multigrid's dinv, Newton's body and the step's
-  // extensions 4, set-up temporaries; 19 x (1 + 1/7) of them, coarse levels
-  // included, and 64 MB for the program bound the measured peak (20.5
-  // vectors at level 12, 20.1 at level 13; perf/RESULTS.md §0u)
-  return 19.0 * 3 * n * 8 * (1 + 1.0 / 7) + 64e6;
+  // extensions 4, set-up temporaries; 18 x (1 + 1/7) of them, coarse levels
+  // included, and 64 MB for the program bound the measured peak (19.6
+  // vectors at level 12, 19.2 at 13, 19.0 at 14; perf/RESULTS.md §0u)
+  return 18.0 * 3 * n * 8 * (1 + 1.0 / 7) + 64e6;
 }
 
 double estimated_memory_bytes_per_rank(const ProblemSpec& s, int ranks) {
