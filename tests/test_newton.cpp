@@ -634,7 +634,7 @@ TEST(SemismoothNewton, RejectsAnInitialStateWithoutItsScaleOrBody) {
   const index p = P.contact_nodes();
   const ContactConditions law = ContactConditions::uniform(p, 1, 0);
   const std::vector<real> u0(3 * p, 0.0), l0(p, 0.0), r0(3 * p, 1.0);
-  const Field<real> body(S.full_size(), 0.0);
+  Field<real> body(S.full_size(), 0.0);
   NewtonOptions o;
   o.u0 = &u0;
   o.lambda0 = &l0;
@@ -643,7 +643,7 @@ TEST(SemismoothNewton, RejectsAnInitialStateWithoutItsScaleOrBody) {
   o.r0 = &r0;
   EXPECT_THROW(semismooth_newton(S, law, o), std::invalid_argument);
   o.body0 = &body;
-  const Field<real> short_body(7, 0.0);
+  Field<real> short_body(7, 0.0);
   o.body0 = &short_body;
   EXPECT_THROW(semismooth_newton(S, law, o), std::invalid_argument);
 }

@@ -109,11 +109,12 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, ContactConditions la
       C.reason = CoulombReason::iteration_limit;
       return C;
     }
-    // continue from this solution, its residual and body
+    // continue from this solution, its residual and body (the body taken
+    // by the next solve, whose result replaces this one)
     no.u0 = &L.u;
     no.lambda0 = &L.lambda;
     no.r0 = &L.r;
-    no.body0 = &L.body;
+    no.body0 = &C.last.body;
     no.force_scale = L.force_scale;
   }
 }

@@ -184,6 +184,7 @@ void choose_initial_iterate(const SteklovPoincare& S, const RunOptions& opt, con
     start.body = std::move(start.given_body);
     start.r0 = std::move(start.r_given);
   }
+  start.given_body = {};  // (the loser's body: not held through Newton)
   newton.r0 = &start.r0;
   newton.r0_accuracy = choice_rtol;
 }

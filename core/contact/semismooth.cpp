@@ -458,7 +458,7 @@ NewtonSolve::NewtonSolve(const SteklovPoincare& S_, const ContactConditions& giv
   if (opt.u0) x.u = placed_field<real>(*opt.u0);
   if (opt.lambda0) x.lambda = placed_field<real>(*opt.lambda0);
   if (opt.body0) {
-    R.body = *opt.body0;
+    R.body = std::move(*opt.body0);  // (taken: NewtonOptions::body0)
     R.body.move_to(launch_space());
   } else {
     R.body = Field<real>(nf);

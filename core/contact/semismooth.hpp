@@ -145,8 +145,10 @@ struct NewtonOptions {
   const std::vector<real>* u0 = nullptr;
   const std::vector<real>* lambda0 = nullptr;
   // optional: a guess of the body's displacement at u0 (S.full_size(),
-  // steklov.hpp: residual), e.g. a coarser mesh's, interpolated
-  const Field<real>* body0 = nullptr;
+  // steklov.hpp: residual), e.g. a coarser mesh's, interpolated. Taken: the
+  // solve moves it into its result's body (left empty), so that one copy of
+  // the body lives, not two
+  Field<real>* body0 = nullptr;
   // |b̃| [N], the scale of r's absolute accuracy; 0: |r| at x0 = 0 (= |b̃|).
   // Required with u0 (e.g. from a loose SteklovPoincare::condensed_load,
   // through force_scale_of).
