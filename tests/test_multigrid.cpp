@@ -2,6 +2,9 @@
 // whose element counts are odd (non-nested coarse grids).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numeric>
+
 #include <Eigen/SparseCholesky>
 
 #include "core/solvers/cg.hpp"
@@ -298,6 +301,44 @@ TEST(CG, ReportsMaxIterationsInsteadOfLooping) {
   const SolveStats st = pcg(A, nullptr, b.data(), u.data(), o, ws);
   EXPECT_EQ(st.reason, SolveReason::max_iterations);
   EXPECT_EQ(st.iterations, 5);
+}
+
+TEST(CG, SideProductIsBOfTheSolutionOrAddsOntoTheCallersOne) {
+  // A: the 1D Laplacian (n = 40), B x = (sum of x, x[0] - x[n-1]): the
+  // side product of the solution, set or (side_adds) added onto what the
+  // caller put there, against B applied to the solution afterwards
+  const index n = 40;
+  class Laplace1D : public LinearOperatorWithSide {
+   public:
+    index size() const override { return n; }
+    index side_size() const override { return 2; }
+    void apply(const real* x, real* y) const override {
+      for (index i = 0; i < n; ++i) y[i] = 2 * x[i] - (i > 0 ? x[i - 1] : 0) - (i + 1 < n ? x[i + 1] : 0);
+    }
+    void apply(const real* x, real* y, real* s) const override {
+      apply(x, y);
+      s[0] = std::accumulate(x, x + n, real(0));
+      s[1] = x[0] - x[n - 1];
+    }
+  } A;
+  const auto b = test::random_vector(n, 71);
+  for (bool adds : {false, true})
+    for (bool zero_guess : {true, false}) {
+      std::vector<real> x(n, 0.0), side = {3.0, -5.0};
+      if (!zero_guess) x = test::random_vector(n, 72);
+      CGOptions o;
+      o.rtol = 1e-13;
+      o.side_adds = adds;
+      o.zero_initial_guess = zero_guess;
+      CGWorkspace ws;
+      const SolveStats st = pcg(A, nullptr, b.data(), x.data(), side.data(), o, ws);
+      ASSERT_TRUE(st.ok()) << to_string(st.reason);
+      std::vector<real> Ax(n), Bx(2);
+      A.apply(x.data(), Ax.data(), Bx.data());
+      const std::vector<real> want = adds ? std::vector<real>{3.0 + Bx[0], -5.0 + Bx[1]} : Bx;
+      for (int k = 0; k < 2; ++k)
+        EXPECT_NEAR(side[k], want[k], 1e-9 * (1 + std::abs(Bx[k]))) << "adds " << adds << " zero guess " << zero_guess;
+    }
 }
 
 TEST(CG, ReportsNonFiniteInput) {

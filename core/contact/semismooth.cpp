@@ -216,13 +216,14 @@ struct StepOutcome {
 
 // Solves the reduced system of L for Δu_F (into du) to the relative
 // accuracy eta (forcing term; semismooth.hpp: Tolerances), floored at the
-// absolute `floor`; side gets the CG's running estimates [S Δu | E Δu] of the
-// whole step (known increments included; inexact; GMRES: the known part only).
+// absolute `floor`; side gets the estimates [S Δu | E Δu] of the whole step:
+// the known increments' (applied first), then the CG's running ones added
+// (inexact; GMRES: the known part only).
 StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreconditioner* M, real eta, real floor,
                        real s_bound, bool any_known, InnerWork& work, CGWorkspace& ws, Field<real>& du,
-                       Field<real>& side, Field<real>& known_side) {
+                       Field<real>& side) {
   const index n3 = S.size(), nf = S.full_size();
-  real* scratch = known_side.data();  // S Δu_known, then E Δu_known
+  real* known = side.data();  // [S Δu_known | E Δu_known], then the CG's added
   StepOutcome out;
   const long long fails0 = work.failures;
   auto norm = [&](const real* x) { return std::sqrt(S.sum(dot(n3, x, x))); };
@@ -238,13 +239,13 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
   out.known_applied = any_known && (L.coupled || known_bound > known_accuracy);
   if (out.known_applied) {
     const real rtol = L.coupled ? 0.1 * eta : known_accuracy / known_bound;
-    if (!work.apply(S, L.known.data(), scratch, std::clamp(rtol, real(1e-12), inner_max), scratch + n3)) {
+    if (!work.apply(S, L.known.data(), known, std::clamp(rtol, real(1e-12), inner_max), known + n3)) {
       out.inner_failed = true;
       return out;
     }
-    subtract_known(L, n3 / 3, scratch, L.rhs.data());
+    subtract_known(L, n3 / 3, known, L.rhs.data());
   } else {
-    fill<real>(n3 + nf, 0, scratch);
+    fill<real>(n3 + nf, 0, known);
   }
   if (M) M->update(L.h, L.fixed, L.free);
   ReducedNewtonOperator A(S, L, work);
@@ -273,14 +274,13 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
     go.reduction = co.reduction;
     ScopedTimer t(Kernel::outer_cg);
     out.outer = gmres(A, M, L.rhs.data(), du.data(), go);
-    fill<real>(n3 + nf, 0, side.data());
   } else {
     ScopedTimer t(Kernel::outer_cg);
+    co.side_adds = true;  // onto the known increments' part
     out.outer = pcg(A, M, L.rhs.data(), du.data(), side.data(), co, ws);
   }
   if (M) work.fine_matvecs += out.outer.preconditioner_applications * M->apply_work();
   out.inner_failed = work.failures > fails0;
-  axpy(n3 + nf, 1, scratch, side.data());
   return out;
 }
 
@@ -409,8 +409,8 @@ class NewtonSolve {
   // the iterate x, and a trial point of the line search (its own bound:
   // Coulomb's bound of a rejected trial must not outlive it)
   Point x, trial;
-  // side: [S Δu | E Δu] of the step; known_side: the same of its known increments
-  Field<real> du, side, known_side, dlambda;
+  // side: [S Δu | E Δu] of the step
+  Field<real> du, side, dlambda;
   ReducedSystem L;
   std::unique_ptr<BoundaryPreconditioner> M;
   CGWorkspace ws;
@@ -432,7 +432,6 @@ NewtonSolve::NewtonSolve(const SteklovPoincare& S_, const ContactConditions& giv
       trial(p),
       du(n3),
       side(n3 + nf),
-      known_side(n3 + nf),
       dlambda(p),
       L(n3),
       eta(opt_.forcing_max) {
@@ -573,7 +572,7 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
 std::optional<NewtonReason> NewtonSolve::newton_step() {
   // (any rank's known increments make every rank apply S to them: S is collective)
   const bool any_known = S.max(linearise(p, scale_ptr, x, opt.friction, L) ? 1 : 0) > 0;
-  const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * tol, smax, any_known, work, ws, du, side, known_side);
+  const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * tol, smax, any_known, work, ws, du, side);
   R.outer_iterations += step.outer.iterations;
   R.operator_applications += step.outer.iterations + (step.known_applied ? 1 : 0);
   if (step.inner_failed) return NewtonReason::inner_failure;

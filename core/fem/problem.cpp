@@ -209,10 +209,10 @@ double estimated_memory_bytes(const ProblemSpec& s) {
   // fine-grid vectors of 3n doubles: Steklov buffers and the load 5, inner
   // CG 4, the V-cycle's work vectors (float: b, x, r, d; shared by the two
   // multigrids) and each multigrid's dinv, Newton's body and the step's
-  // extensions 3, set-up temporaries; 18 x (1 + 1/7) of them, coarse levels
-  // included, and 64 MB for the program bound the measured peak (18.5
-  // vectors at level 12, 18.2 at 13; perf/RESULTS.md §0u)
-  return 18.0 * 3 * n * 8 * (1 + 1.0 / 7) + 64e6;
+  // side products 3, set-up temporaries; 17 x (1 + 1/7) of them, coarse
+  // levels included, and 64 MB for the program bound the measured peak
+  // (17.6 vectors at level 12, 17.2 at 13; perf/RESULTS.md §0u)
+  return 17.0 * 3 * n * 8 * (1 + 1.0 / 7) + 64e6;
 }
 
 double estimated_memory_bytes_per_rank(const ProblemSpec& s, int ranks) {

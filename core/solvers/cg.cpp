@@ -52,10 +52,13 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
   if (opt.zero_initial_guess) {
     fill<real>(n, 0, x);
     copy(n, b, r);
-    if (side) fill<real>(side->side_size(), 0, side_x);
+    if (side && !opt.side_adds) fill<real>(side->side_size(), 0, side_x);
   } else {
     apply(x, q);
-    if (side) copy(side->side_size(), sp, side_x);
+    if (side && opt.side_adds)
+      axpy(side->side_size(), 1, sp, side_x);
+    else if (side)
+      copy(side->side_size(), sp, side_x);
     copy(n, b, r);
     axpy(n, -1, q, r);
   }

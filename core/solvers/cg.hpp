@@ -39,6 +39,9 @@ struct CGOptions {
   real atol = 0;
   int max_iterations = 1000;
   bool zero_initial_guess = true;  // otherwise x holds the initial guess
+  // with a side product: side_x += B x onto the caller's side_x (otherwise
+  // side_x = B x), e.g. onto B x_known of a part of the solution known before
+  bool side_adds = false;
   // called with ||r|| of the initial residual and after every update (lets an
   // inexactly applied A relax its accuracy as the residual falls)
   std::function<void(real rnorm)> on_residual;
@@ -57,8 +60,9 @@ struct CGWorkspace {
 
 SolveStats pcg(const LinearOperator& A, const LinearOperator* M, const real* b, real* x, const CGOptions& opt,
                CGWorkspace& ws);
-// The same, and side_x = B x for the solution x (operator.hpp): B p comes with
-// every A p, and side_x += alpha B p with every step x += alpha p.
+// The same, and side_x = B x for the solution x (operator.hpp; side_adds:
+// side_x += B x): B p comes with every A p, and side_x += alpha B p with
+// every step x += alpha p.
 SolveStats pcg(const LinearOperatorWithSide& A, const LinearOperator* M, const real* b, real* x, real* side_x,
                const CGOptions& opt, CGWorkspace& ws);
 
