@@ -190,44 +190,11 @@ Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscret
     build_work<double>(like);
 }
 
-template <>
-std::shared_ptr<Multigrid::Cycle<double>>& Multigrid::cycle<double>() {
-  return work_d_;
-}
-template <>
-std::shared_ptr<Multigrid::Cycle<float>>& Multigrid::cycle<float>() {
-  return work_s_;
-}
-template <>
-const std::shared_ptr<Multigrid::Cycle<double>>& Multigrid::cycle<double>() const {
-  return work_d_;
-}
-template <>
-const std::shared_ptr<Multigrid::Cycle<float>>& Multigrid::cycle<float>() const {
-  return work_s_;
-}
-template <>
-std::vector<Field<double>>& Multigrid::dinv<double>() {
-  return dinv_d_;
-}
-template <>
-std::vector<Field<float>>& Multigrid::dinv<float>() {
-  return dinv_s_;
-}
-template <>
-const std::vector<Field<double>>& Multigrid::dinv<double>() const {
-  return dinv_d_;
-}
-template <>
-const std::vector<Field<float>>& Multigrid::dinv<float>() const {
-  return dinv_s_;
-}
-
 template <class T>
 void Multigrid::build_work(const Multigrid* like) {
-  std::shared_ptr<Cycle<T>>& C = cycle<T>();
-  if (like && like->cycle<T>()) {
-    C = like->cycle<T>();  // (the same hierarchy, so the same sizes)
+  std::shared_ptr<Cycle<T>>& C = held<T>().cycle;
+  if (like && like->held<T>().cycle) {
+    C = like->held<T>().cycle;  // (the same hierarchy, so the same sizes)
   } else {
     C = std::make_shared<Cycle<T>>();
     C->levels.resize(levels_.size());
@@ -255,7 +222,7 @@ void Multigrid::build_work(const Multigrid* like) {
 
 template <class T>
 void Multigrid::refresh_work() {
-  std::vector<Field<T>>& D = dinv<T>();
+  std::vector<Field<T>>& D = held<T>().dinv;
   D.resize(levels_.size());
   for (size_t l = 0; l < levels_.size(); ++l) {
     const Field<real> d = levels_[l].A.diagonal();
@@ -356,7 +323,7 @@ void Multigrid::residual(int l, const T* b, T* x, T* r) const {
 template <class T>
 void Multigrid::smooth(int l, bool zero_guess, const T* in) const {
   Work<T>& w = work<T>()[l];
-  const T* dinv_l = dinv<T>()[l].data();
+  const T* dinv_l = held<T>().dinv[l].data();
   ScopedTimer t(Kernel::smoother);
   const ElasticityOperator& A = levels_[l].A;
   chebyshev_smooth<T>(
@@ -429,15 +396,19 @@ void Multigrid::vcycle(int l) const {
   smooth<T>(l, true);
   residual<T>(l, w.bp, w.xp, w.r.data());
   restrict_residual<T>(l);
-  if (grids_->agglomerated(l + 1)) {
-    // the coarse levels on rank 0 alone; their correction to every rank
-    Work<T>& cw = work<T>()[l + 1];
-    if (comm().rank() == 0) vcycle<T>(l + 1);
-    comm().broadcast(cw.x.data(), int(cw.x.size()));
-  } else {
-    vcycle<T>(l + 1);
-  }
+  vcycle_on_ranks<T>(l + 1);
   smooth<T>(l, false, prolongate_correction<T>(l));
+}
+
+template <class T>
+void Multigrid::vcycle_on_ranks(int l) const {
+  if (!grids_->agglomerated(l)) {
+    vcycle<T>(l);
+    return;
+  }
+  // this level and the coarser ones on rank 0 alone; their correction to every rank
+  if (comm().rank() == 0) vcycle<T>(l);
+  comm().broadcast(work<T>()[l].xp, int(levels_[l].A.size()));
 }
 
 namespace {
@@ -469,28 +440,25 @@ void Multigrid::check_launch_space() const {
 void Multigrid::apply(const real* r, real* z) const {
   check_launch_space();
   const index n = size();
-  // every level whole on several ranks: rank 0 alone, the answer to all
-  const bool alone = grids_->agglomerated(0), run = !alone || comm().rank() == 0;
   if (opt_.precision == Precision::double_precision) {
-    const InUse busy(*work_d_);
+    const InUse busy(*held<double>().cycle);
     Work<double>& w = work<double>()[0];
     w.bp = r;
     w.xp = z;
-    if (run) vcycle<double>(0);
+    vcycle_on_ranks<double>(0);
   } else {
-    const InUse busy(*work_s_);
+    const InUse busy(*held<float>().cycle);
     Work<float>& w = work<float>()[0];
     convert<float>(n, r, w.b.data());
-    if (run) vcycle<float>(0);
+    vcycle_on_ranks<float>(0);
     convert<double>(n, w.x.data(), z);
   }
-  if (alone) comm().broadcast(z, int(n));
   levels_[0].A.zero_ghosts(z);
 }
 
 template <class T>
 void Multigrid::vcycle_at(const Field<index>& at, const real* r, real* z) const {
-  const InUse busy(*cycle<T>());
+  const InUse busy(*held<T>().cycle);
   Work<T>& w = work<T>()[0];
   const index n = size(), m = index(at.size());
   if (index(w.x.size()) != n) {  // (a double level 0 otherwise solves in the caller's arrays)
@@ -501,9 +469,7 @@ void Multigrid::vcycle_at(const Field<index>& at, const real* r, real* z) const 
   w.bp = w.b.data();
   fill<T>(n, 0, w.b.data());
   scatter_to(m, at.data(), r, w.b.data());
-  const bool alone = grids_->agglomerated(0);
-  if (!alone || comm().rank() == 0) vcycle<T>(0);
-  if (alone) comm().broadcast(w.x.data(), int(n));
+  vcycle_on_ranks<T>(0);
   gather_from(m, at.data(), w.x.data(), z);
 }
 

@@ -57,6 +57,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "kernels/transfer.hpp"
@@ -191,16 +192,18 @@ class Multigrid : public LinearOperator {
     std::vector<Work<T>> levels;
     bool busy = false;  // a V-cycle is running in these vectors
   };
+  // what the multigrid holds in precision T (the V-cycles' one is built)
   template <class T>
-  std::shared_ptr<Cycle<T>>& cycle();
+  struct InPrecision {
+    std::shared_ptr<Cycle<T>> cycle;  // shared with a multigrid built `like` this one
+    std::vector<Field<T>> dinv;       // per level: 1 / diag(K + B), 0 on ghost rows
+  };
   template <class T>
-  const std::shared_ptr<Cycle<T>>& cycle() const;
+  InPrecision<T>& held() { return std::get<InPrecision<T>>(held_); }
   template <class T>
-  std::vector<Work<T>>& work() const { return cycle<T>()->levels; }  // (scratch: written by const applies)
+  const InPrecision<T>& held() const { return std::get<InPrecision<T>>(held_); }
   template <class T>
-  std::vector<Field<T>>& dinv();  // per level: 1 / diag(K + B), 0 on ghost rows
-  template <class T>
-  const std::vector<Field<T>>& dinv() const;
+  std::vector<Work<T>>& work() const { return held<T>().cycle->levels; }  // (scratch: written by const applies)
   template <class T>
   void build_work(const Multigrid* like);
   template <class T>
@@ -211,6 +214,10 @@ class Multigrid : public LinearOperator {
   void smooth(int l, bool zero_guess, const T* in = nullptr) const;
   template <class T>
   void vcycle(int l) const;
+  // vcycle(l); where level l is the first held whole on several ranks
+  // (agglomerated), rank 0 alone runs it and broadcasts its correction xp
+  template <class T>
+  void vcycle_on_ranks(int l) const;
   template <class T>
   void vcycle_at(const Field<index>& at, const real* r, real* z) const;
   template <class T>
@@ -225,10 +232,7 @@ class Multigrid : public LinearOperator {
   MGOptions opt_;
   std::shared_ptr<const GridHierarchy> grids_;
   std::vector<Level> levels_;
-  std::shared_ptr<Cycle<double>> work_d_;
-  std::shared_ptr<Cycle<float>> work_s_;
-  std::vector<Field<double>> dinv_d_;
-  std::vector<Field<float>> dinv_s_;
+  std::tuple<InPrecision<double>, InPrecision<float>> held_;
   Eigen::SimplicialLDLT<SparseMatrix> coarse_;  // on rank 0 (every rank when all levels are whole)
   // the pattern coarse_ was ordered for (its fill-reducing ordering is kept
   // while the pattern stays: each bottom block only refactorises)
