@@ -4,7 +4,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "kernels/launch.hpp"
 #include "kernels/vector_ops.hpp"
 
 namespace tresca {
@@ -52,14 +51,6 @@ void copy_rows(const GridDims& ga, const real* a, index src_row, const GridDims&
 void global_to_local(const Slab& s, const real* global, real* local) {
   const index first = s.y_begin - s.lo, rows = s.owned_rows() + s.lo + s.hi;
   copy_rows(s.global, global, first, s.local, local, 0, rows);
-}
-
-Field<real> local_rows(const Slab& s, const real* host_global) {
-  HostLaunches host;  // (the copy reads host memory)
-  Field<real> local(3 * s.local.nodes());
-  global_to_local(s, host_global, local.data());
-  local.move_to(host.space_before());
-  return local;
 }
 
 void local_to_global(const Slab& s, const real* local, real* global) {

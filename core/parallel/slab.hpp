@@ -55,9 +55,6 @@ void buffer_to_rows(const GridDims& g, const T* buf, index r0, index r1, T* v) {
 
 // SoA (3 components) global vector -> rank's local vector (owned and ghost rows)
 void global_to_local(const Slab& s, const real* global, real* local);
-// the same from a global vector in host memory (e.g. Problem::load) into a
-// new Field where the launches run (kernels/launch.hpp)
-Field<real> local_rows(const Slab& s, const real* host_global);
 // the owned rows of a local vector -> their places in a global vector (other rows untouched)
 void local_to_global(const Slab& s, const real* local, real* global);
 
