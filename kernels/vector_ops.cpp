@@ -22,25 +22,46 @@ inline real hsum(V v) {
   for (index l = 0; l < kL; ++l) s += v[l];
   return s;
 }
-
-real dot(index n, const real* x, const real* y) {
-  return sum_over_blocks(n, kDotBlock, kDotCost, [x, y](index i0, index i1) {
-    V s0{}, s1{};
-    index i = i0;
-    for (; i + 2 * kL <= i1; i += 2 * kL) {
-      s0 += load(x + i) * load(y + i);
-      s1 += load(x + i + kL) * load(y + i + kL);
-    }
-    for (; i + kL <= i1; i += kL) s0 += load(x + i) * load(y + i);
-    real s = hsum(s0 + s1);
-    for (; i < i1; ++i) s += x[i] * y[i];
-    return s;
-  }, [x, y](index i) { return x[i] * y[i]; });
+// kL entries from p as doubles (floats widened)
+inline V load_real(const real* p) { return load(p); }
+inline V load_real(const float* p) {
+  typedef float H __attribute__((vector_size(kSimdBytes / 2), aligned(alignof(float)), may_alias));
+  return __builtin_convertvector(*reinterpret_cast<const H*>(p), V);
 }
 
-real dot_ref(index n, const real* x, const real* y) {
+// The sum over [i0, i1) of x_i y_i, or with weights w of x_i (w_i y_i), in
+// double: a reduction's block on the host
+template <bool Weighted, class T>
+real block_dot(index i0, index i1, const T* x, const T* w, const T* y) {
+  auto term = [=](index i) {
+    if constexpr (Weighted)
+      return load_real(x + i) * (load_real(w + i) * load_real(y + i));
+    else
+      return load_real(x + i) * load_real(y + i);
+  };
+  V s0{}, s1{};
+  index i = i0;
+  for (; i + 2 * kL <= i1; i += 2 * kL) {
+    s0 += term(i);
+    s1 += term(i + kL);
+  }
+  for (; i + kL <= i1; i += kL) s0 += term(i);
+  real s = hsum(s0 + s1);
+  for (; i < i1; ++i) s += real(x[i]) * (Weighted ? real(w[i]) * real(y[i]) : real(y[i]));
+  return s;
+}
+
+template <class T>
+real dot(index n, const T* x, const T* y) {
+  return sum_over_blocks(n, kDotBlock, in_precision<T>(kDotCost),
+                         [x, y](index i0, index i1) { return block_dot<false>(i0, i1, x, x, y); },
+                         [x, y](index i) { return real(x[i]) * real(y[i]); });
+}
+
+template <class T>
+real dot_ref(index n, const T* x, const T* y) {
   real s = 0;
-  for (index i = 0; i < n; ++i) s += x[i] * y[i];
+  for (index i = 0; i < n; ++i) s += real(x[i]) * real(y[i]);
   return s;
 }
 
@@ -99,6 +120,34 @@ real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real*
   return dot_ref(n, r, r);
 }
 
+template <class T>
+real jacobi_cg_update(index n, T a, const T* q, const T* dinv, T* r) {
+  // the update, then its block's sum while r is in cache
+  return sum_over_blocks(n, kDotBlock, in_precision<T>(kJacobiCgUpdateCost), [=](index i0, index i1) {
+#pragma omp simd
+    for (index i = i0; i < i1; ++i) r[i] -= a * q[i];
+    return block_dot<true>(i0, i1, r, dinv, r);
+  }, [=](index i) {
+    r[i] -= a * q[i];
+    return real(r[i]) * (real(dinv[i]) * real(r[i]));
+  });
+}
+
+template <class T>
+real jacobi_cg_update_ref(index n, T a, const T* q, const T* dinv, T* r) {
+  real s = 0;
+  for (index i = 0; i < n; ++i) {
+    r[i] -= a * q[i];
+    s += real(r[i]) * (real(dinv[i]) * real(r[i]));
+  }
+  return s;
+}
+
+template <class T>
+void jacobi_xpay(index n, const T* dinv, const T* r, T b, T* p) {
+  for_each_entry(n, in_precision<T>(kJacobiXpayCost), [=](index i) { p[i] = dinv[i] * r[i] + b * p[i]; });
+}
+
 template <class To, class From>
 void convert(index n, const From* x, To* y) {
   for_each_entry(n, Cost{double(sizeof(From) + sizeof(To)), 0}, [=](index i) { y[i] = To(x[i]); });
@@ -138,6 +187,16 @@ void cheb_first(index n, T t, const T* dinv, const T* r, T* d, T* x, bool from_z
     });
 }
 
+template real dot<double>(index, const double*, const double*);
+template real dot<float>(index, const float*, const float*);
+template real dot_ref<double>(index, const double*, const double*);
+template real dot_ref<float>(index, const float*, const float*);
+template real jacobi_cg_update<double>(index, double, const double*, const double*, double*);
+template real jacobi_cg_update<float>(index, float, const float*, const float*, float*);
+template real jacobi_cg_update_ref<double>(index, double, const double*, const double*, double*);
+template real jacobi_cg_update_ref<float>(index, float, const float*, const float*, float*);
+template void jacobi_xpay<double>(index, const double*, const double*, double, double*);
+template void jacobi_xpay<float>(index, const float*, const float*, float, float*);
 template void fill<double>(index, double, double*);
 template void fill<float>(index, float, float*);
 template void reciprocal_or_zero<double>(index, const real*, double*);

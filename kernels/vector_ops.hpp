@@ -8,8 +8,11 @@
 //   dot 16n B, 2n F;  axpy 24n B, 2n F;  xpay 24n B, 2n F;
 //   cg_update (x += a p, r -= a q, returns r.r) 48n B, 6n F;
 //   cheb_update (d = s d + t Dinv r, x += d) 40n B, 5n F;
-//   cheb_first (d = t Dinv b, x = d) 32n B, 2n F; (..., x += d) 40n B, 3n F.
-// (Fields of float move half the bytes: in_precision<float>, types.hpp.)
+//   cheb_first (d = t Dinv b, x = d) 32n B, 2n F; (..., x += d) 40n B, 3n F;
+//   jacobi_cg_update (r -= a q, returns r.(Dinv r)) 32n B, 5n F;
+//   jacobi_xpay (p = Dinv r + b p) 32n B, 3n F.
+// (Fields of float move half the bytes: in_precision<float>, types.hpp.
+// Sums are taken in double for float vectors too.)
 #pragma once
 #include "types.hpp"
 
@@ -19,10 +22,12 @@ constexpr index kDotBlock = 4096;
 // per entry (the table above)
 constexpr Cost kDotCost{16, 2}, kAxpyCost{24, 2}, kXpayCost{24, 2}, kCgUpdateCost{48, 6}, kChebUpdateCost{40, 5},
     kChebFirstCost{32, 2}, kChebFirstOnGuessCost{40, 3}, kCopyCost{16, 0}, kFillCost{8, 0}, kScaleCost{16, 1},
-    kHadamardCost{24, 1};
+    kHadamardCost{24, 1}, kJacobiCgUpdateCost{32, 5}, kJacobiXpayCost{32, 3};
 
-real dot(index n, const real* x, const real* y);
-real dot_ref(index n, const real* x, const real* y);
+template <class T>
+real dot(index n, const T* x, const T* y);  // T = double, float
+template <class T>
+real dot_ref(index n, const T* x, const T* y);
 real norm2(index n, const real* x);
 void axpy(index n, real a, const real* x, real* y);        // y += a x
 void xpay(index n, const real* x, real a, real* y);        // y = x + a y
@@ -46,6 +51,15 @@ void reciprocal_or_zero(index n, const real* x, To* y);
 // x += a p; r -= a q; returns r.r
 real cg_update(index n, real a, const real* p, const real* q, real* x, real* r);
 real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real* r);
+// Jacobi-preconditioned CG without its iterate (the Lanczos estimate of
+// the smoother's lmax, core/multigrid/smoothing.hpp; T = double, float):
+// r -= a q, returning r.(dinv .* r); and p = dinv .* r + b p
+template <class T>
+real jacobi_cg_update(index n, T a, const T* q, const T* dinv, T* r);
+template <class T>
+real jacobi_cg_update_ref(index n, T a, const T* q, const T* dinv, T* r);
+template <class T>
+void jacobi_xpay(index n, const T* dinv, const T* r, T b, T* p);
 // d = s d + t dinv .* r; x += d   (T = double, float): a smoother step's
 // update unfused from its residual (the V-cycle runs the fused step of the
 // apply, apply_out.hpp; this is bench_kernels' ChebStepUnfused reference)

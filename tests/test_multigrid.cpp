@@ -5,12 +5,14 @@
 #include <cmath>
 #include <numeric>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 
 #include "core/solvers/cg.hpp"
 #include "core/multigrid/interior.hpp"
 #include "core/multigrid/multigrid.hpp"
 #include "core/multigrid/smoothing.hpp"
+#include "core/fem/assembly.hpp"
 #include "core/fem/problem.hpp"
 #include "kernels/vector_ops.hpp"
 #include "test_helpers.hpp"
@@ -72,6 +74,54 @@ TEST(Chebyshev, EveryDegreeAndEntryGivesTheTextbookIterate) {
       EXPECT_EQ(residuals, fused_entry ? 0 : 1) << "degree " << degree << " entry " << entry;
       EXPECT_EQ(steps, degree - (entry == 0 || !fused_entry ? 1 : 0)) << "degree " << degree << " entry " << entry;
     }
+}
+
+// lanczos_lmax against the largest eigenvalue of D^{-1}K from a dense
+// symmetric eigensolver (of D^{-1/2} K D^{-1/2}, K assembled element by
+// element), in double and in float: its Ritz value lies below the true one
+// and close to it, the float run within float rounding of the double one,
+// and a multigrid's levels get the estimate of the V-cycle's precision
+TEST(Lanczos, EstimatesTheLargestEigenvalueOfTheJacobiScaledOperatorInBothPrecisions) {
+  const Problem P = make_problem(spec_for_dims(7, 4, 5));
+  const ElasticityOperator K(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+  const index n = K.size();
+  const Eigen::MatrixXd A(assemble(K));
+  const Eigen::VectorXd s = A.diagonal().cwiseInverse().cwiseSqrt();
+  const Eigen::MatrixXd scaled = s.asDiagonal() * A * s.asDiagonal();
+  const real exact = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scaled, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  ASSERT_GT(exact, 2.1);  // (above the estimate's floor of 2)
+  const auto start = test::random_vector(n, 31);
+  const Field<real> d = K.diagonal();
+  auto estimate = [&](auto zero) {
+    using T = decltype(zero);
+    Field<T> dinv = Field<T>(std::size_t(n)), r = Field<T>(std::size_t(n));
+    reciprocal_or_zero<T>(n, d.data(), dinv.data());
+    for (index i = 0; i < n; ++i) r[i] = T(start[i]);
+    return lanczos_lmax<T>(n, [&](T* p, T* q) { K.apply(p, q); }, dinv, std::move(r)) / 1.15;
+  };
+  const real lmax = estimate(0.0), lmax_f = estimate(0.0f);
+  EXPECT_LE(lmax, exact * (1 + 1e-12));
+  EXPECT_GE(lmax, 0.999 * exact);  // (4.5e-6 below it when written)
+  EXPECT_NEAR(lmax_f, lmax, 1e-6 * lmax);  // (3.7e-9 apart when written)
+
+  const Problem Q = make_problem(spec_for_dims(16, 8, 8));
+  real level_lmax[2][8] = {};
+  int levels = 0;
+  for (Precision prec : {Precision::double_precision, Precision::single_precision}) {
+    MGOptions mo;
+    mo.precision = prec;
+    mo.coarse_nodes = 60;
+    const Multigrid mg(Q.grid, Q.interior_faces, Q.spec.E, Q.spec.nu, mo);
+    levels = mg.num_levels();
+    ASSERT_LE(levels, 8);
+    for (int l = 0; l + 1 < levels; ++l) level_lmax[prec == Precision::single_precision][l] = mg.lmax(l);
+  }
+  ASSERT_GE(levels, 3);
+  for (int l = 0; l + 1 < levels; ++l) {
+    EXPECT_GT(level_lmax[0][l], 2.3) << "level " << l;
+    EXPECT_NE(level_lmax[0][l], level_lmax[1][l]) << "level " << l << ": float and double estimates should round apart";
+    EXPECT_NEAR(level_lmax[1][l], level_lmax[0][l], 1e-5 * level_lmax[0][l]) << "level " << l;
+  }
 }
 
 TEST(MultigridCG, MatchesSparseDirectSolveOnOddMeshes) {

@@ -5,6 +5,7 @@
 #include <omp.h>
 
 #include <cmath>
+#include <limits>
 
 #include "core/fem/problem.hpp"
 #include "core/util/profile.hpp"
@@ -33,16 +34,56 @@ TEST(VectorOps, DotAndCgUpdateMatchReferenceOnAwkwardLengths) {
   }
 }
 
+// the Lanczos estimate's kernels (double and float vectors, sums in double)
+// against their _ref twins and the plain loops they fuse
+TEST(VectorOps, JacobiCgStepsMatchReferenceInBothPrecisions) {
+  auto check = [](auto zero, real tol) {
+    using T = decltype(zero);
+    for (index n : kLengths) {
+      std::vector<T> q(n), dinv(n), r1(n), p1(n), x(n);
+      const auto a = test::random_vector(n, 7), b = test::random_vector(n, 8), c = test::random_vector(n, 9),
+                 e = test::random_vector(n, 10);
+      for (index i = 0; i < n; ++i) {
+        q[i] = T(a[i]);
+        dinv[i] = T(1.5 + b[i]);
+        r1[i] = T(c[i]);
+        p1[i] = T(e[i]);
+        x[i] = T(b[i]);
+      }
+      auto r2 = r1, p2 = p1;
+      const real s = jacobi_cg_update<T>(n, T(0.37), q.data(), dinv.data(), r1.data());
+      const real s_ref = jacobi_cg_update_ref<T>(n, T(0.37), q.data(), dinv.data(), r2.data());
+      EXPECT_NEAR(s, s_ref, tol * std::abs(s_ref)) << "n = " << n;
+      real plain = 0;
+      for (index i = 0; i < n; ++i) plain += real(r2[i]) * real(dinv[i]) * real(r2[i]);
+      EXPECT_NEAR(s, plain, tol * std::abs(plain)) << "n = " << n;
+      for (index i = 0; i < n; ++i) ASSERT_EQ(r1[i], r2[i]) << "n = " << n << ", entry " << i;
+      jacobi_xpay<T>(n, dinv.data(), r1.data(), T(-0.6), p1.data());
+      for (index i = 0; i < n; ++i)
+        ASSERT_NEAR(p1[i], dinv[i] * r2[i] - T(0.6) * p2[i], 4 * std::numeric_limits<T>::epsilon() * 4) << "n = " << n;
+      const real d = dot<T>(n, q.data(), x.data()), d_ref = dot_ref<T>(n, q.data(), x.data());
+      EXPECT_NEAR(d, d_ref, tol * double(n)) << "n = " << n;
+    }
+  };
+  check(0.0, 1e-13);
+  check(0.0f, 1e-13);  // (float entries, exact products and sums in double)
+}
+
 TEST(VectorOps, ReductionsAreBitwiseIndependentOfThreadCount) {
   const index n = 100003;
   const auto x = test::random_vector(n, 5), y = test::random_vector(n, 6);
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);
   const real d1 = dot(n, x.data(), y.data());
+  auto r1 = y;
+  const real j1 = jacobi_cg_update(n, 0.37, x.data(), y.data(), r1.data());
   omp_set_num_threads(2);
   const real d2 = dot(n, x.data(), y.data());
+  auto r2 = y;
+  const real j2 = jacobi_cg_update(n, 0.37, x.data(), y.data(), r2.data());
   omp_set_num_threads(threads);
   EXPECT_EQ(d1, d2);
+  EXPECT_EQ(j1, j2);
 }
 
 // The host's one partition (launch.hpp): every entry on one worker, shares

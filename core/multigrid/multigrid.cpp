@@ -177,17 +177,20 @@ Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscret
       throw std::invalid_argument("multigrid: the rediscretised operator does not live on the hierarchy's grid");
     levels_.push_back(std::move(lv));
   }
-  for (int l = 0; l + 1 < num_levels(); ++l) {
-    if (like)
-      levels_[l].lmax = like->levels_[l].lmax;
-    else
-      estimate_lmax(l);
-  }
-  factor_coarse();
-  if (opt_.precision == Precision::single_precision)
+  const bool single = opt_.precision == Precision::single_precision;
+  if (single)
     build_work<float>(like);
   else
     build_work<double>(like);
+  for (int l = 0; l + 1 < num_levels(); ++l) {
+    if (like)
+      levels_[l].lmax = like->levels_[l].lmax;
+    else if (single)
+      estimate_lmax<float>(l);
+    else
+      estimate_lmax<double>(l);
+  }
+  factor_coarse();
 }
 
 template <class T>
@@ -231,40 +234,40 @@ void Multigrid::refresh_work() {
   }
 }
 
+template <class T>
 void Multigrid::estimate_lmax(int l) {
   Level& lv = levels_[l];
   const GridHierarchy::Level& h = grids_->levels[l];
   const index n = lv.A.size();
-  Field<real> dinv = lv.A.diagonal();
-  reciprocal_or_zero(n, dinv.data(), dinv.data());
   // the start vector by global dof index: runs of nx entries (one node row,
   // each from its own jump of the generator), made on the host's threads and
   // moved where the launches run
   const GridDims &box = h.slab.local, &G = h.grid;
   const index N = box.nodes(), row0 = h.slab.y_begin - h.slab.lo, ny = box.ny(), nz = box.nz();
-  Field<real> r;
+  Field<T> r;
   {
     HostLaunches host;
-    r = Field<real>(std::size_t(n));
-    real* start = r.data();
+    r = Field<T>(std::size_t(n));
+    T* start = r.data();
     for_each_host_block(3 * nz * ny, double(n) * Cost{8, 4}, [=, &G, &box](index row) {
       const index c = row / (nz * ny), iz = (row / ny) % nz, j = row % ny;
       const index k0 = c * G.nodes() + G.node(0, row0 + j, iz);
       std::uint64_t s = Lcg::jump(12345, std::uint64_t(k0) + 1);
-      real* out = start + c * N + box.node(0, j, iz);
-      for (index ix = 0; ix < box.nx(); ++ix, s = Lcg::a * s + Lcg::c) out[ix] = Lcg::value(s);
+      T* out = start + c * N + box.node(0, j, iz);
+      for (index ix = 0; ix < box.nx(); ++ix, s = Lcg::a * s + Lcg::c) out[ix] = T(Lcg::value(s));
     });
     r.move_to(host.space_before());
   }
   zero_constrained(box, lv.A.faces(), r.data());
   lv.A.zero_ghosts(r.data());
-  lv.lmax = lanczos_lmax(
+  // in the smoother's precision, with its inverse diagonal (refresh_work)
+  lv.lmax = lanczos_lmax<T>(
       n,
-      [&](real* p, real* q) {
+      [&](T* p, T* q) {
         lv.A.update_ghosts(p);
         lv.A.apply(p, q);
       },
-      dinv, std::move(r), h.distributed ? grids_->comm : nullptr);
+      held<T>().dinv[std::size_t(l)], std::move(r), h.distributed ? grids_->comm : nullptr);
 }
 
 void Multigrid::factor_coarse() {

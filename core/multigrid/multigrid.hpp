@@ -25,8 +25,8 @@
 // rank and many.
 //
 // Smoother: Chebyshev polynomial of degree `degree` in D^{-1}A (Jacobi),
-// targeting [lmax/range, lmax]; lmax from 15 steps of Jacobi-PCG (Lanczos),
-// times 1.15, from a start vector that depends on the global dof index only
+// targeting [lmax/range, lmax]; lmax from 15 steps of Jacobi-PCG (Lanczos)
+// in the V-cycle's precision, times 1.15, from a start vector that depends on the global dof index only
 // (the same on any rank count). The same polynomial pre and post keeps the
 // V-cycle symmetric, so it is a valid CG preconditioner.
 //
@@ -175,7 +175,7 @@ class Multigrid : public LinearOperator {
 
  private:
   struct Level {
-    ElasticityOperator A;  // double: lmax estimate, coarse factorisation, op()
+    ElasticityOperator A;  // double (coarse factorisation, op()) and float
     real lmax = 0;
   };
   // The V-cycle's vectors of one level in precision T: the scratch of one
@@ -226,7 +226,8 @@ class Multigrid : public LinearOperator {
   T* prolongate_correction(int l) const;  // into the post-smoother's entry; returns it
   void check_launch_space() const;  // throws std::logic_error: built for one space, applied in the other
   void factor_coarse();
-  void estimate_lmax(int l);
+  template <class T>
+  void estimate_lmax(int l);  // after build_work<T>
   const Comm& comm() const { return *grids_->comm; }
 
   MGOptions opt_;

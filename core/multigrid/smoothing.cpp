@@ -6,37 +6,44 @@
 
 namespace tresca {
 
-real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const Field<real>& dinv,
-                  Field<real> r, const Reduction* reduce) {
-  // Lanczos through Jacobi-PCG: T_jj = 1/a_j + b_{j-1}/a_{j-1}, T_j,j+1 = sqrt(b_j)/a_j
+template <class T>
+real lanczos_lmax(index n, const std::function<void(T*, T*)>& apply, const Field<T>& dinv, Field<T> r,
+                  const Reduction* reduce) {
+  // Lanczos through Jacobi-PCG: T_jj = 1/a_j + b_{j-1}/a_{j-1}, T_j,j+1 = sqrt(b_j)/a_j,
+  // with a_j, b_j as the vectors' precision holds them (the coefficients of
+  // the recursion actually run); the iterate itself is not needed
   auto global = [&](real s) { return reduce ? reduce->sum(s) : s; };
-  Field<real> x(n, 0), z(n), p(n), q(n);
-  hadamard(n, dinv.data(), r.data(), z.data());
-  copy(n, z.data(), p.data());
-  real rz = global(dot(n, r.data(), z.data()));
+  Field<T> p(n), q(n);  // (zeros)
+  // r.(D^-1 r), the update by a = 0; p = D^-1 r
+  real rz = global(jacobi_cg_update<T>(n, 0, p.data(), dinv.data(), r.data()));
+  jacobi_xpay<T>(n, dinv.data(), r.data(), 0, p.data());
   std::vector<real> al, be;
   const int its = 15;
   for (int j = 0; j < its && rz > 0; ++j) {
     apply(p.data(), q.data());
-    const real a = rz / global(dot(n, p.data(), q.data()));
-    cg_update(n, a, p.data(), q.data(), x.data(), r.data());
-    hadamard(n, dinv.data(), r.data(), z.data());
-    const real rz_new = global(dot(n, r.data(), z.data()));
+    const T a = T(rz / global(dot(n, p.data(), q.data())));
+    const real rz_new = global(jacobi_cg_update(n, a, q.data(), dinv.data(), r.data()));
+    const T b = T(rz_new / rz);
     al.push_back(a);
-    be.push_back(rz_new / rz);
-    xpay(n, z.data(), rz_new / rz, p.data());
+    be.push_back(b);
+    jacobi_xpay(n, dinv.data(), r.data(), b, p.data());
     rz = rz_new;
   }
   const int m = int(al.size());
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(m, m);
+  Eigen::MatrixXd Tm = Eigen::MatrixXd::Zero(m, m);
   for (int j = 0; j < m; ++j) {
-    T(j, j) = 1 / al[j] + (j > 0 ? be[j - 1] / al[j - 1] : 0);
-    if (j + 1 < m) T(j, j + 1) = T(j + 1, j) = std::sqrt(be[j]) / al[j];
+    Tm(j, j) = 1 / al[j] + (j > 0 ? be[j - 1] / al[j - 1] : 0);
+    if (j + 1 < m) Tm(j, j + 1) = Tm(j + 1, j) = std::sqrt(be[j]) / al[j];
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T, Eigen::EigenvaluesOnly);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Tm, Eigen::EigenvaluesOnly);
   // B terms of the Newton preconditioner (PSD, 2x2 blocks) keep D^{-1}(K+B) below max(lmax, 2)
   return 1.15 * std::max(es.eigenvalues().maxCoeff(), real(2));
 }
+
+template real lanczos_lmax<double>(index, const std::function<void(double*, double*)>&, const Field<double>&,
+                                   Field<double>, const Reduction*);
+template real lanczos_lmax<float>(index, const std::function<void(float*, float*)>&, const Field<float>&,
+                                  Field<float>, const Reduction*);
 
 std::vector<real> project_bottom_block(const Transfer& t, const std::vector<real>& Bf) {
   const GridDims &fg = t.fine, &cg = t.coarse;

@@ -12,7 +12,7 @@
 //   one; in the other vector the first step forms a residual and updates the
 //   iterate in place (`residual(x, y)`, y = b - A x, into the free vector).
 // * lanczos_lmax: the largest eigenvalue of D^{-1}A from 15 steps of
-//   Jacobi-PCG (Lanczos), times 1.15, at least 2.3; dots through `reduce`
+//   Jacobi-PCG (Lanczos), times 1.15, at least 2.3, in double or float; dots through `reduce`
 //   (the sum over the ranks of a split level; null: one part);
 // * project_bottom_block: P^T B of a bottom-plane block, lumped per entry.
 #pragma once
@@ -69,9 +69,13 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
 }
 
 // r: the start vector (overwritten); apply(p, q): q = A p (p is the
-// estimate's own vector: apply may update its ghost entries)
-real lanczos_lmax(index n, const std::function<void(real*, real*)>& apply, const Field<real>& dinv,
-                  Field<real> r, const Reduction* reduce = nullptr);
+// estimate's own vector: apply may update its ghost entries). T = double,
+// float: the vectors and the steps' coefficients in T, the sums in double
+// (the smoother's own operator and precision: Multigrid runs it in the
+// V-cycle's)
+template <class T>
+real lanczos_lmax(index n, const std::function<void(T*, T*)>& apply, const Field<T>& dinv, Field<T> r,
+                  const Reduction* reduce = nullptr);
 
 // the coarse bottom block P^T B of the fine one (4 fields of nx*ny each;
 // host data, t's lists on the host: GridHierarchy::Link::whole)
