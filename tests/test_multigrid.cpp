@@ -103,6 +103,9 @@ TEST(Lanczos, EstimatesTheLargestEigenvalueOfTheJacobiScaledOperatorInBothPrecis
   EXPECT_LE(lmax, exact * (1 + 1e-12));
   EXPECT_GE(lmax, 0.999 * exact);  // (4.5e-6 below it when written)
   EXPECT_NEAR(lmax_f, lmax, 1e-6 * lmax);  // (3.7e-9 apart when written)
+  // no free entry to start from: no step, the floor
+  EXPECT_EQ(lanczos_lmax<real>(n, [&](real* p, real* q) { K.apply(p, q); }, K.diagonal(), Field<real>(std::size_t(n))),
+            1.15 * 2);
 
   const Problem Q = make_problem(spec_for_dims(16, 8, 8));
   real level_lmax[2][8] = {};

@@ -21,7 +21,9 @@ real lanczos_lmax(index n, const std::function<void(T*, T*)>& apply, const Field
   const int its = 15;
   for (int j = 0; j < its && rz > 0; ++j) {
     apply(p.data(), q.data());
-    const T a = T(rz / global(dot(n, p.data(), q.data())));
+    const real pq = global(dot(n, p.data(), q.data()));
+    if (!(pq > 0)) break;  // (p in A's null space, or A not positive: the steps so far)
+    const T a = T(rz / pq);
     const real rz_new = global(jacobi_cg_update(n, a, q.data(), dinv.data(), r.data()));
     const T b = T(rz_new / rz);
     al.push_back(a);
@@ -29,15 +31,21 @@ real lanczos_lmax(index n, const std::function<void(T*, T*)>& apply, const Field
     jacobi_xpay(n, dinv.data(), r.data(), b, p.data());
     rz = rz_new;
   }
+  // B terms of the Newton preconditioner (PSD, 2x2 blocks) keep D^{-1}(K+B)
+  // below max(lmax, 2); no step at all (no free entry): D^{-1}A = I
+  constexpr real kSafety = 1.15, kFloor = 2;
   const int m = int(al.size());
-  Eigen::MatrixXd Tm = Eigen::MatrixXd::Zero(m, m);
-  for (int j = 0; j < m; ++j) {
-    Tm(j, j) = 1 / al[j] + (j > 0 ? be[j - 1] / al[j - 1] : 0);
-    if (j + 1 < m) Tm(j, j + 1) = Tm(j + 1, j) = std::sqrt(be[j]) / al[j];
+  real largest = kFloor;
+  if (m > 0) {
+    Eigen::MatrixXd Tm = Eigen::MatrixXd::Zero(m, m);
+    for (int j = 0; j < m; ++j) {
+      Tm(j, j) = 1 / al[j] + (j > 0 ? be[j - 1] / al[j - 1] : 0);
+      if (j + 1 < m) Tm(j, j + 1) = Tm(j + 1, j) = std::sqrt(be[j]) / al[j];
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Tm, Eigen::EigenvaluesOnly);
+    largest = std::max(es.eigenvalues().maxCoeff(), kFloor);
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Tm, Eigen::EigenvaluesOnly);
-  // B terms of the Newton preconditioner (PSD, 2x2 blocks) keep D^{-1}(K+B) below max(lmax, 2)
-  return 1.15 * std::max(es.eigenvalues().maxCoeff(), real(2));
+  return kSafety * largest;
 }
 
 template real lanczos_lmax<double>(index, const std::function<void(double*, double*)>&, const Field<double>&,
