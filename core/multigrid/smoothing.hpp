@@ -12,8 +12,9 @@
 //   one; in the other vector the first step forms a residual and updates the
 //   iterate in place (`residual(x, y)`, y = b - A x, into the free vector).
 // * lanczos_lmax: the largest eigenvalue of D^{-1}A from 15 steps of
-//   Jacobi-PCG (Lanczos), times 1.15, at least 2.3, in double or float; dots through `reduce`
-//   (the sum over the ranks of a split level; null: one part);
+//   Jacobi-PCG (Lanczos) in double or float, times 1.15, at least 2.3;
+//   dots through `reduce` (the sum over the ranks of a split level; null:
+//   one part);
 // * project_bottom_block: P^T B of a bottom-plane block, lumped per entry.
 #pragma once
 #include <functional>
