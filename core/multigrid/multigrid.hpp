@@ -27,8 +27,9 @@
 // Smoother: Chebyshev polynomial of degree `degree` in D^{-1}A (Jacobi),
 // targeting [lmax/range, lmax]; lmax from 15 steps of Jacobi-PCG (Lanczos)
 // in the V-cycle's precision, times 1.15, from a start vector that depends
-// on the global dof index only (the same on any rank count). The same polynomial pre and post keeps the
-// V-cycle symmetric, so it is a valid CG preconditioner.
+// on the global dof index only (the same on any rank count). The same
+// polynomial pre and post keeps the V-cycle symmetric, so it is a valid CG
+// preconditioner.
 //
 // Optional bottom-face block B (elasticity_operator.hpp): coarse levels get
 // the lumped Galerkin projection B_c = P^T B_f (restricted per entry), which
