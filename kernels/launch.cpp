@@ -74,7 +74,10 @@ LaunchCounts launch_counts() {
 void set_launch_on_device(bool on) {
   if (on && !offload_built())
     throw std::invalid_argument("this build has no device backend (configure with -DTRESCA_OFFLOAD=ON)");
-  if (on) device_warps();  // a bad TRESCA_DEVICE_WARPS stops here, before any launch
+  if (on) {  // a bad TRESCA_DEVICE_WARPS or _MIN_NODES stops here, before any launch
+    device_warps();
+    device_min_nodes();
+  }
   on_device = on;
 }
 
@@ -89,6 +92,19 @@ int device_warps() {
     return int(w);
   }();
   return warps;
+}
+
+index device_min_nodes() {
+  static const index nodes = [] {
+    const char* e = std::getenv("TRESCA_DEVICE_MIN_NODES");
+    if (e == nullptr || *e == '\0') return index(32768);
+    char* end = nullptr;
+    const long long n = std::strtoll(e, &end, 10);
+    if (*end != '\0' || n < 0)
+      throw std::invalid_argument(std::string("TRESCA_DEVICE_MIN_NODES=") + e + " must be a node count >= 0");
+    return index(n);
+  }();
+  return nodes;
 }
 
 namespace {
@@ -403,7 +419,8 @@ void* device_scratch(std::size_t bytes) {
 std::string device_description() {
   if (!offload_built()) return "none (built without offload)";
   const int n = omp_get_num_devices();
-  const std::string teams = ", " + std::to_string(device_warps()) + " warps a team";
+  const std::string teams = ", " + std::to_string(device_warps()) + " warps a team, multigrid levels under " +
+                            std::to_string(device_min_nodes()) + " nodes on the host";
   if (n == 0) return "none: target regions run on the host" + teams;
   return "device " + std::to_string(omp_get_default_device()) + " of " + std::to_string(n) + " (OpenMP offload)" + teams;
 }

@@ -43,8 +43,9 @@ namespace tresca {
 bool launch_on_device();
 void set_launch_on_device(bool on);  // throws std::invalid_argument if the build has no offload
 bool offload_built();                // whether this build has TRESCA_OFFLOAD
-// "device 0 of 1 (OpenMP offload), 8 warps a team", "none: target regions
-// run on the host, 8 warps a team" or "none (built without offload)"
+// "device 0 of 1 (OpenMP offload), 8 warps a team, multigrid levels under
+// 32768 nodes on the host", "none: target regions run on the host, 8 warps
+// a team, ..." or "none (built without offload)"
 std::string device_description();
 
 // Warps a team of every device launch: the thread_limit of its target region
@@ -57,14 +58,27 @@ std::string device_description();
 // libgomp's own. Throws std::invalid_argument for any other value.
 int device_warps();
 
+// The smallest multigrid level the device runs (in nodes): in a device run
+// the coarser levels run on the host (GridHierarchy, core/multigrid), where
+// a sweep of a few ten thousand nodes costs about what one target region's
+// launch does (perf/RESULTS.md §0w), and their right-hand side and
+// correction cross once a V-cycle. From TRESCA_DEVICE_MIN_NODES (a count
+// >= 0; 0: every level on the device), read once; default 32768. Throws
+// std::invalid_argument for any other value.
+index device_min_nodes();
+
 // Launches (and new Fields) are the host's inside this scope, and where
 // they were before after it: for builders that fill Fields entry by entry
 // and then move what they made to space_before() (build_elasticity_stencil,
-// build_transfer). A builder called inside another's scope builds on the
-// host, and the outer one moves the whole.
+// build_transfer), and for work that belongs on the host in a device run
+// (the coarse multigrid levels: `when` true for those, false for the
+// others). A builder called inside another's scope builds on the host, and
+// the outer one moves the whole.
 class HostLaunches {
  public:
-  HostLaunches() : was_(launch_on_device()) { set_launch_on_device(false); }
+  explicit HostLaunches(bool when = true) : was_(launch_on_device()) {
+    if (when) set_launch_on_device(false);
+  }
   ~HostLaunches() { set_launch_on_device(was_); }
   HostLaunches(const HostLaunches&) = delete;
   HostLaunches& operator=(const HostLaunches&) = delete;

@@ -338,7 +338,10 @@ TEST(Device, TransfersOnTheDeviceMatchTheHost) {
 }
 
 // a whole MG-preconditioned CG solve with every operator, level and Krylov
-// vector made on the device: the host's iterations and solution
+// vector made on the device, the coarse levels on the host from none to
+// all but the finest (GridHierarchy's device_min_nodes; the guard checks
+// that each side reads only its own memory): the host's iterations and
+// solution
 TEST(Device, MultigridSolveOnTheDeviceMatchesTheHost) {
   if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
   for (Precision prec : {Precision::double_precision, Precision::single_precision})
@@ -347,23 +350,35 @@ TEST(Device, MultigridSolveOnTheDeviceMatchesTheHost) {
       MGOptions mo;
       mo.precision = prec;
       mo.coarse_nodes = 60;
-      const Multigrid hmg(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
+      const Rediscretisation op = elasticity_on(P.interior_faces, P.spec.E, P.spec.nu);
+      const Multigrid hmg(GridHierarchy::build(P.grid, mo.coarse_nodes, Comm::self(), kMinNodesPerRank, 200), op, mo);
+      ASSERT_EQ(hmg.num_levels(), 4);  // 4032-4056, 637, 112, 36 nodes
+      for (int l = 0; l < 4; ++l) EXPECT_FALSE(hmg.hierarchy()->levels[l].on_host) << "a host run has no host levels";
       const InteriorSolution h = solve_interior_elasticity(P, hmg, 1e-10);
-      InteriorSolution d;
-      {
-        OnDevice on;
-        const Multigrid dmg(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
-        ASSERT_EQ(dmg.num_levels(), hmg.num_levels());
-        ASSERT_TRUE(dmg.op(0).stencil().groups.on_device());
-        d = solve_interior_elasticity(P, dmg, 1e-10);
-        EXPECT_TRUE(d.u.on_device());
+      // device_min_nodes -> the first level on the host (4: none)
+      for (const auto& [min_nodes, first_host] : {std::pair<index, int>{0, 4}, {200, 2}, {index(1) << 40, 1}}) {
+        const std::string what = std::string(to_string(prec)) + (odd ? ", 23x11x13" : ", level 5") +
+                                 ", device_min_nodes " + std::to_string(min_nodes);
+        InteriorSolution d;
+        {
+          OnDevice on;
+          const Multigrid dmg(GridHierarchy::build(P.grid, mo.coarse_nodes, Comm::self(), kMinNodesPerRank, min_nodes),
+                              op, mo);
+          ASSERT_EQ(dmg.num_levels(), hmg.num_levels()) << what;
+          for (int l = 0; l < dmg.num_levels(); ++l) {
+            EXPECT_EQ(dmg.hierarchy()->levels[l].on_host, l >= first_host) << what << ", level " << l;
+            EXPECT_EQ(dmg.op(l).stencil().groups.on_device(), l < first_host) << what << ", level " << l;
+          }
+          EXPECT_EQ(dmg.describe().find("(h)") != std::string::npos, first_host < 4) << what;
+          d = solve_interior_elasticity(P, dmg, 1e-10);
+          EXPECT_TRUE(d.u.on_device()) << what;
+        }
+        ASSERT_TRUE(h.stats.ok() && d.stats.ok()) << what;
+        EXPECT_EQ(d.stats.iterations, h.stats.iterations) << what;
+        EXPECT_NEAR(d.relative_residual, h.relative_residual, 0.1 * h.relative_residual) << what;
+        const std::vector<real> hu = h.u.to_vector();
+        EXPECT_LE(test::max_abs_diff(d.u.to_vector(), hu), 1e-10 * test::max_abs(hu)) << what;
       }
-      const std::string what = std::string(to_string(prec)) + (odd ? ", 23x11x13" : ", level 5");
-      ASSERT_TRUE(h.stats.ok() && d.stats.ok()) << what;
-      EXPECT_EQ(d.stats.iterations, h.stats.iterations) << what;
-      EXPECT_NEAR(d.relative_residual, h.relative_residual, 0.1 * h.relative_residual) << what;
-      const std::vector<real> hu = h.u.to_vector();
-      EXPECT_LE(test::max_abs_diff(d.u.to_vector(), hu), 1e-10 * test::max_abs(hu)) << what;
     }
 }
 

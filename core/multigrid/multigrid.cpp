@@ -116,7 +116,7 @@ std::string rank_layout(const GridDims& g, const Comm& comm, const std::string& 
 }
 
 std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, index coarse_nodes, const Comm& comm,
-                                                          index min_nodes_per_rank) {
+                                                          index min_nodes_per_rank, index device_min_nodes) {
   auto h = std::make_shared<GridHierarchy>();
   h->comm = &comm;
   std::vector<GridDims> grids;
@@ -134,10 +134,15 @@ std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, 
     whole = whole || coarsest || !worth_distributing(lv.grid, comm, min_nodes_per_rank);
     lv.distributed = !whole;
     lv.slab = lv.distributed ? make_slab(lv.grid, comm.rank(), comm.size()) : make_slab(lv.grid, 0, 1);
+    // (nodes fall from level to level: once a level is on the host, so are the coarser ones)
+    lv.on_host = launch_on_device() && !comm.distributed() && l > 0 && lv.grid.nodes() < device_min_nodes;
     h->levels.push_back(lv);
   }
-  for (size_t l = 0; l + 1 < h->levels.size(); ++l)
+  for (size_t l = 0; l + 1 < h->levels.size(); ++l) {
+    // the transfers where level l's V-cycle runs them (the fine side's launches)
+    const HostLaunches host(h->levels[l].on_host);
     h->to_coarse.push_back(make_link(build_transfer(grids[l], grids[l + 1]), h->levels[l], h->levels[l + 1], comm));
+  }
   return h;
 }
 
@@ -171,6 +176,7 @@ Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscret
   if (like && like->grids_ != grids_)
     throw std::invalid_argument("multigrid: spectral bounds can only be shared on the same hierarchy");
   for (const GridHierarchy::Level& h : grids_->levels) {
+    const HostLaunches where(h.on_host);  // each level made where it runs
     Level lv;
     lv.A = op(h.slab);
     if (lv.A.grid().nodes() != h.slab.local.nodes())
@@ -204,11 +210,21 @@ void Multigrid::build_work(const Multigrid* like) {
     for (size_t l = 0; l < levels_.size(); ++l) {
       Work<T>& w = C->levels[l];
       const index n = levels_[l].A.size();
+      const bool crosses = grids_->crosses_to_host(int(l));
+      if (crosses) {  // (where the finer level runs: the device)
+        w.x.resize(n);
+        w.b.resize(n);
+      }
+      const HostLaunches where(on_host(l));
       w.r.resize(n);
       w.d.resize(n);
-      // a double level 0 solves in the caller's arrays (apply sets xp, bp)
-      if (l > 0 || !std::is_same<T, real>::value) {
-        w.x.resize(n);
+      if (crosses) {
+        w.host_x.resize(n);
+        w.host_b.resize(n);
+        w.xp = w.host_x.data();
+        w.bp = w.host_b.data();
+      } else if (l > 0 || !std::is_same<T, real>::value) {  // (a double level 0 solves in the
+        w.x.resize(n);                                       // caller's arrays: apply sets xp, bp)
         w.b.resize(n);
         w.xp = w.x.data();
         w.bp = w.b.data();
@@ -228,6 +244,7 @@ void Multigrid::refresh_work() {
   std::vector<Field<T>>& D = held<T>().dinv;
   D.resize(levels_.size());
   for (size_t l = 0; l < levels_.size(); ++l) {
+    const HostLaunches where(on_host(l));
     const Field<real> d = levels_[l].A.diagonal();
     D[l].resize(d.size());
     reciprocal_or_zero<T>(index(d.size()), d.data(), D[l].data());  // ghost rows: 0
@@ -236,6 +253,7 @@ void Multigrid::refresh_work() {
 
 template <class T>
 void Multigrid::estimate_lmax(int l) {
+  const HostLaunches where(on_host(std::size_t(l)));
   Level& lv = levels_[l];
   const GridHierarchy::Level& h = grids_->levels[l];
   const index n = lv.A.size();
@@ -305,7 +323,10 @@ void Multigrid::set_bottom_block(const std::vector<real>& B) {
   for (size_t l = 0; l < levels_.size(); ++l) {
     const ElasticityOperator& A = levels_[l].A;
     zero_constrained_bottom_block(grids_->levels[l].grid, A.global_faces(), Bl);
-    levels_[l].A.set_bottom_block(Bl);
+    {
+      const HostLaunches where(on_host(l));
+      levels_[l].A.set_bottom_block(Bl);
+    }
     if (l + 1 == levels_.size() || Bl.empty()) continue;
     Bl = project_bottom_block(grids_->to_coarse[l].whole, Bl);  // P^T B
   }
@@ -399,12 +420,24 @@ void Multigrid::vcycle(int l) const {
   smooth<T>(l, true);
   residual<T>(l, w.bp, w.xp, w.r.data());
   restrict_residual<T>(l);
-  vcycle_on_ranks<T>(l + 1);
+  vcycle_where_held<T>(l + 1);
   smooth<T>(l, false, prolongate_correction<T>(l));
 }
 
 template <class T>
-void Multigrid::vcycle_on_ranks(int l) const {
+void Multigrid::vcycle_where_held(int l) const {
+  if (grids_->crosses_to_host(l)) {  // (a device run: one rank)
+    ScopedTimer t(Kernel::host_levels);
+    Work<T>& w = work<T>()[l];
+    const std::size_t bytes = std::size_t(levels_[l].A.size()) * sizeof(T);
+    space_copy(Space::host, w.host_b.data(), Space::device, w.b.data(), bytes);
+    {
+      const HostLaunches host;
+      vcycle<T>(l);
+    }
+    space_copy(Space::device, w.x.data(), Space::host, w.host_x.data(), bytes);
+    return;
+  }
   if (!grids_->agglomerated(l)) {
     vcycle<T>(l);
     return;
@@ -448,12 +481,12 @@ void Multigrid::apply(const real* r, real* z) const {
     Work<double>& w = work<double>()[0];
     w.bp = r;
     w.xp = z;
-    vcycle_on_ranks<double>(0);
+    vcycle_where_held<double>(0);
   } else {
     const InUse busy(*held<float>().cycle);
     Work<float>& w = work<float>()[0];
     convert<float>(n, r, w.b.data());
-    vcycle_on_ranks<float>(0);
+    vcycle_where_held<float>(0);
     convert<double>(n, w.x.data(), z);
   }
   levels_[0].A.zero_ghosts(z);
@@ -472,7 +505,7 @@ void Multigrid::vcycle_at(const Field<index>& at, const real* r, real* z) const 
   w.bp = w.b.data();
   fill<T>(n, 0, w.b.data());
   scatter_to(m, at.data(), r, w.b.data());
-  vcycle_on_ranks<T>(0);
+  vcycle_where_held<T>(0);
   gather_from(m, at.data(), w.x.data(), z);
 }
 
@@ -496,9 +529,14 @@ double Multigrid::cycle_work() const {
 std::string Multigrid::describe() const {
   std::ostringstream os;
   os << levels_.size() << " levels:";
-  for (const GridHierarchy::Level& h : grids_->levels)
-    os << " " << h.grid.ex << "x" << h.grid.ey << "x" << h.grid.ez << (h.distributed ? "(d)" : "");
+  bool host = false;
+  for (const GridHierarchy::Level& h : grids_->levels) {
+    os << " " << h.grid.ex << "x" << h.grid.ey << "x" << h.grid.ez << (h.distributed ? "(d)" : "")
+       << (h.on_host ? "(h)" : "");
+    host = host || h.on_host;
+  }
   os << " (" << to_string(opt_.precision) << " precision";
+  if (host) os << "; (h): on the host, the finer ones on the device";
   if (comm().distributed() && grids_->distributed_levels() > 0)
     os << "; (d): split over " << comm().size() << " ranks, the others agglomerated on rank 0";
   else if (comm().distributed())

@@ -61,6 +61,7 @@
 #include <tuple>
 #include <vector>
 
+#include "kernels/launch.hpp"
 #include "kernels/transfer.hpp"
 #include "core/fem/assembly.hpp"
 #include "core/fem/elasticity_operator.hpp"
@@ -98,6 +99,11 @@ struct GridHierarchy {
     GridDims grid;             // the whole grid
     Slab slab;                 // this rank's part: its slab if split, else the whole grid
     bool distributed = false;  // split over the ranks
+    // held and run on the host while the finer levels run on the device: in
+    // a device run, a level other than the finest with fewer than
+    // device_min_nodes() nodes (kernels/launch.hpp), where a launch would
+    // cost more than the host's sweep; false in a host run
+    bool on_host = false;
   };
   // from level l to l + 1
   struct Link {
@@ -114,12 +120,21 @@ struct GridHierarchy {
   // level l is the first whole level on several ranks: it and the coarser
   // ones are computed by rank 0 alone
   bool agglomerated(int l) const;
+  // level l is the first on the host in a device run: its right-hand side
+  // is restricted on the device and crosses to the host, its correction
+  // crosses back
+  bool crosses_to_host(int l) const { return levels[l].on_host && (l == 0 || !levels[l - 1].on_host); }
   std::vector<GridDims> grids() const;  // the levels' whole grids
   int distributed_levels() const;
   // semi-coarsening until a grid has at most coarse_nodes nodes; levels
-  // split over comm's ranks where worth_distributing (Comm::self(): all whole)
+  // split over comm's ranks where worth_distributing (Comm::self(): all
+  // whole); with the launches on the device (one rank), the levels after
+  // the finest with fewer than device_min_nodes nodes on the host, their
+  // transfers made there
   static std::shared_ptr<const GridHierarchy> build(const GridDims& fine, index coarse_nodes,
-                                                    const Comm& comm = Comm::self(), index min_nodes_per_rank = kMinNodesPerRank);
+                                                    const Comm& comm = Comm::self(),
+                                                    index min_nodes_per_rank = kMinNodesPerRank,
+                                                    index device_min_nodes = tresca::device_min_nodes());
 };
 
 // The description of the operator a multigrid preconditions: its
@@ -186,7 +201,10 @@ class Multigrid : public LinearOperator {
   struct Work {
     Field<T> x, b, r, d, fine_rows, coarse_rows;
     T* xp = nullptr;        // iterate and right-hand side in use: the
-    const T* bp = nullptr;  // caller's arrays on a double level 0
+    const T* bp = nullptr;  // caller's arrays on a double level 0, host_x and host_b on
+                            // the first host level of a device run (x and b: their device
+                            // copies, which the finer level's transfers write and read)
+    Field<T> host_x, host_b;
   };
   template <class T>
   struct Cycle {
@@ -215,10 +233,13 @@ class Multigrid : public LinearOperator {
   void smooth(int l, bool zero_guess, const T* in = nullptr) const;
   template <class T>
   void vcycle(int l) const;
-  // vcycle(l); where level l is the first held whole on several ranks
-  // (agglomerated), rank 0 alone runs it and broadcasts its correction xp
+  // vcycle(l) where level l is held: where it is the first held whole on
+  // several ranks (agglomerated), rank 0 alone runs it and broadcasts its
+  // correction xp; where it is the first on the host in a device run, its
+  // right-hand side crosses to the host and its correction back
   template <class T>
-  void vcycle_on_ranks(int l) const;
+  void vcycle_where_held(int l) const;
+  bool on_host(std::size_t l) const { return grids_->levels[l].on_host; }
   template <class T>
   void vcycle_at(const Field<index>& at, const real* r, real* z) const;
   template <class T>

@@ -23,7 +23,8 @@ double parallel_seconds_so_far() { return parallel_seconds(launch_counts()); }
 const char* kernel_name(Kernel k) {
   static const char* names[] = {"apply (K x)", "apply (bottom block)", "diagonal", "smoother (Chebyshev)",
                                 "prolongation", "restriction", "coarse solve", "vector updates",
-                                "contact maps", "inner CG (total)", "outer CG (total)"};
+                                "contact maps", "inner CG (total)", "outer CG (total)",
+                                "host levels (total)"};
   return names[int(k)];
 }
 

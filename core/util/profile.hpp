@@ -11,7 +11,7 @@ namespace tresca {
 
 enum class Kernel : int {
   apply, apply_boundary, diagonal, smoother, prolongate, restrict_, coarse_solve, vector, contact_maps,
-  inner_cg, outer_cg, count
+  inner_cg, outer_cg, host_levels, count
 };
 const char* kernel_name(Kernel k);
 
