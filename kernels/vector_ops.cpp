@@ -87,6 +87,32 @@ void hadamard(index n, const real* d, const real* x, real* y) {
   for_each_entry(n, kHadamardCost, [=](index i) { y[i] = d[i] * x[i]; });
 }
 
+namespace {
+// body(k) at entry k of each of the three runs, one launch
+template <class Body>
+void for_each_component_entry(const ComponentRuns& r, Cost per_entry, const Body& body) {
+  const index N = r.N, first = r.first;
+  for_each_entry(r.count, 3 * per_entry, [=](index i) {
+    body(first + i);
+    body(N + first + i);
+    body(2 * N + first + i);
+  });
+}
+}  // namespace
+
+void axpy(const ComponentRuns& r, real a, const real* x, real* y) {
+  for_each_component_entry(r, kAxpyCost, [=](index k) { y[k] += a * x[k]; });
+}
+void copy(const ComponentRuns& r, const real* x, real* y) {
+  for_each_component_entry(r, kCopyCost, [=](index k) { y[k] = x[k]; });
+}
+void fill(const ComponentRuns& r, real v, real* y) {
+  for_each_component_entry(r, kFillCost, [=](index k) { y[k] = v; });
+}
+void scale(const ComponentRuns& r, real a, real* y) {
+  for_each_component_entry(r, kScaleCost, [=](index k) { y[k] *= a; });
+}
+
 real cg_update(index n, real a, const real* p, const real* q, real* x, real* r) {
   // fused in blocks so that r is still in cache (registers) when r.r is formed
   return sum_over_blocks(n, kDotBlock, kCgUpdateCost, [=](index i0, index i1) {

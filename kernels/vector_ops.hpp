@@ -38,6 +38,17 @@ template <class To, class From>
 void convert(index n, const From* x, To* y);               // y = To(x) (double <-> float)
 void scale(index n, real a, real* y);                      // y *= a
 void hadamard(index n, const real* d, const real* x, real* y);  // y = d .* x
+// The same on the three component blocks of a vector of N nodes (layout
+// c N + node), entries [first, first + count) of each, in one launch: a
+// plane of a 3D vector (core/contact/steklov.cpp), a launch where three
+// were (on a GPU each costs about as much as a plane's work)
+struct ComponentRuns {
+  index N, first, count;
+};
+void axpy(const ComponentRuns& r, real a, const real* x, real* y);
+void copy(const ComponentRuns& r, const real* x, real* y);
+void fill(const ComponentRuns& r, real v, real* y);
+void scale(const ComponentRuns& r, real a, real* y);
 // a short vector's entries placed into, and taken from, entries of a long
 // one: y[at[k]] = To(x[k]) (scatter_to), y[k] = To(x[at[k]]) (gather_from),
 // k < n (To, From: double, float)

@@ -244,6 +244,25 @@ TEST(Device, VectorKernelsOnTheDeviceMatchTheHost) {
     EXPECT_LT(test::max_abs_diff(dx2.to_vector(), hx), 1e-15) << "cg_update x, n = " << n;
     EXPECT_LT(test::max_abs_diff(dr.to_vector(), hr), 1e-15) << "cg_update r, n = " << n;
   }
+  // the three component blocks' runs in one launch (a plane of a 3D vector)
+  const index N = 1003;
+  const ComponentRuns runs{N, 17, 500};
+  const auto x = test::random_vector(3 * N, 4), y = test::random_vector(3 * N, 5);
+  auto hy = y, hz = y;
+  scale(runs, -1, hy.data());
+  axpy(runs, 0.5, x.data(), hy.data());
+  copy(runs, x.data(), hz.data());
+  fill(ComponentRuns{N, 600, 3}, 2.0, hz.data());
+  Field<real> dx = on_device(x), dy = on_device(y), dz = on_device(y);
+  {
+    OnDevice on;
+    scale(runs, -1, dy.data());
+    axpy(runs, 0.5, dx.data(), dy.data());
+    copy(runs, dx.data(), dz.data());
+    fill(ComponentRuns{N, 600, 3}, 2.0, dz.data());
+  }
+  EXPECT_EQ(dy.to_vector(), hy) << "scale, axpy on component runs";
+  EXPECT_EQ(dz.to_vector(), hz) << "copy, fill on component runs";
 }
 
 // device launches are counted and timed as such (the profile's "on the

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "core/fem/problem.hpp"
 #include "core/util/profile.hpp"
@@ -264,6 +265,31 @@ TEST(VectorOps, ChebyshevUpdatesFollowTheirFormulas) {
   for (index i = 0; i < n; ++i) {
     ASSERT_EQ(d1[i], d2[i]);
     ASSERT_EQ(x1[i], x2[i]);
+  }
+}
+
+// the three component blocks' runs in one launch: the plain loops' values
+// there, every other entry untouched (N, first, count awkward: runs that
+// begin mid-block, a run to the block's end, an empty one)
+TEST(VectorOps, ComponentRunsTouchTheirRunsOnly) {
+  const index N = 1003;
+  for (const ComponentRuns r : {ComponentRuns{N, 17, 500}, ComponentRuns{N, 0, N}, ComponentRuns{N, 1002, 1},
+                                ComponentRuns{N, 5, 0}}) {
+    const std::string what = "first " + std::to_string(r.first) + ", count " + std::to_string(r.count);
+    const auto x = test::random_vector(3 * N, 11), y0 = test::random_vector(3 * N, 12);
+    auto in_run = [&](index k) { return k % N >= r.first && k % N < r.first + r.count; };
+    auto y = y0;
+    axpy(r, 0.3, x.data(), y.data());
+    for (index k = 0; k < 3 * N; ++k) ASSERT_EQ(y[k], in_run(k) ? y0[k] + 0.3 * x[k] : y0[k]) << what << ", " << k;
+    y = y0;
+    scale(r, -2.5, y.data());
+    for (index k = 0; k < 3 * N; ++k) ASSERT_EQ(y[k], in_run(k) ? -2.5 * y0[k] : y0[k]) << what << ", " << k;
+    y = y0;
+    copy(r, x.data(), y.data());
+    for (index k = 0; k < 3 * N; ++k) ASSERT_EQ(y[k], in_run(k) ? x[k] : y0[k]) << what << ", " << k;
+    y = y0;
+    fill(r, 7.0, y.data());
+    for (index k = 0; k < 3 * N; ++k) ASSERT_EQ(y[k], in_run(k) ? 7.0 : y0[k]) << what << ", " << k;
   }
 }
 

@@ -115,14 +115,12 @@ SolveStats SteklovPoincare::solve_interior(const real* rhs, real* z, real rtol, 
 
 void SteklovPoincare::set_plane(real* v, index iz, const real* src) const {
   const GridDims& g = box();
-  const index plane = g.nx() * g.ny(), N = g.nodes();
-  for (int a = 0; a < 3; ++a) {
-    real* dst = v + a * N + iz * plane;
-    if (src)
-      copy(plane, src + a * N + iz * plane, dst);
-    else
-      fill<real>(plane, 0, dst);
-  }
+  const index plane = g.nx() * g.ny();
+  const ComponentRuns at{g.nodes(), iz * plane, plane};
+  if (src)
+    copy(at, src, v);
+  else
+    fill(at, 0, v);
 }
 
 SolveStats SteklovPoincare::apply(const real* v, real* Sv, real rtol, real* extension, const real* guess) const {
@@ -148,10 +146,10 @@ SolveStats SteklovPoincare::extend(const real* v, real* li, real* out, real rtol
   scatter(v, w_.data());
   // t = -K_ic v lives on plane 1 (w_ is zero on the x = 0 nodes, so are t's)
   apply_planes(w_.data(), t_.data(), 1, 2);
-  for (int a = 0; a < 3; ++a) scale(plane, -1, t_.data() + a * N + plane);
+  const ComponentRuns plane1{N, plane, plane};
+  scale(plane1, -1, t_.data());
   // right-hand side -K_ic v, or l_i - K_ic v in li itself
-  if (li)
-    for (int a = 0; a < 3; ++a) axpy(plane, 1, t_.data() + a * N + plane, li + a * N + plane);
+  if (li) axpy(plane1, 1, t_.data(), li);
   const SolveStats st = solve_interior(li ? li : t_.data(), z_.data(), rtol, guess);
   // u = w + z: z vanishes on the constrained plane 0, where w lives
   set_plane(z_.data(), 0, w_.data());
