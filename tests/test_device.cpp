@@ -412,6 +412,22 @@ TEST(Device, HostMadeMultigridIsRefusedOnTheDevice) {
   EXPECT_THROW(mg.apply(r.data(), z.data()), std::logic_error);
 }
 
+// a multigrid on a hierarchy built with the launches elsewhere (whose
+// finest transfers live there): refused when it is made, either way
+TEST(Device, MultigridOnAHierarchyOfTheOtherSideIsRefused) {
+  if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
+  const Problem P = make_problem(spec_for_level(3));
+  const Rediscretisation op = elasticity_on(P.interior_faces, P.spec.E, P.spec.nu);
+  const auto on_host = GridHierarchy::build(P.grid, 60);
+  std::shared_ptr<const GridHierarchy> on_device;
+  {
+    OnDevice on;
+    on_device = GridHierarchy::build(P.grid, 60);
+    EXPECT_THROW(Multigrid(on_host, op), std::logic_error);
+  }
+  EXPECT_THROW(Multigrid(on_device, op), std::logic_error);
+}
+
 // the whole contact solve (nested iteration, Newton, the final check) with
 // every operator, level, Krylov and contact vector made on the device: the
 // host's Newton and Krylov iterations, contact values to 1e-10 relative

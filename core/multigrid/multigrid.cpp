@@ -119,6 +119,7 @@ std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, 
                                                           index min_nodes_per_rank, index device_min_nodes) {
   auto h = std::make_shared<GridHierarchy>();
   h->comm = &comm;
+  h->space = launch_space();
   std::vector<GridDims> grids;
   GridDims g = fine;
   for (;;) {
@@ -175,6 +176,9 @@ Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscret
   if (!grids_ || grids_->levels.empty()) throw std::invalid_argument("multigrid: empty grid hierarchy");
   if (like && like->grids_ != grids_)
     throw std::invalid_argument("multigrid: spectral bounds can only be shared on the same hierarchy");
+  if (grids_->space != launch_space())
+    throw std::logic_error(std::string("multigrid: its grid hierarchy was built with the launches on the ") +
+                           to_string(grids_->space) + ", the multigrid with them on the " + to_string(launch_space()));
   for (const GridHierarchy::Level& h : grids_->levels) {
     const HostLaunches where(h.on_host);  // each level made where it runs
     Level lv;
@@ -430,12 +434,12 @@ void Multigrid::vcycle_where_held(int l) const {
     ScopedTimer t(Kernel::host_levels);
     Work<T>& w = work<T>()[l];
     const std::size_t bytes = std::size_t(levels_[l].A.size()) * sizeof(T);
-    space_copy(Space::host, w.host_b.data(), Space::device, w.b.data(), bytes);
+    space_copy(Space::host, w.host_b.data(), grids_->space, w.b.data(), bytes);
     {
       const HostLaunches host;
       vcycle<T>(l);
     }
-    space_copy(Space::device, w.x.data(), Space::host, w.host_x.data(), bytes);
+    space_copy(grids_->space, w.x.data(), Space::host, w.host_x.data(), bytes);
     return;
   }
   if (!grids_->agglomerated(l)) {

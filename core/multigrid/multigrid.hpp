@@ -117,6 +117,9 @@ struct GridHierarchy {
   std::vector<Level> levels;  // finest first
   std::vector<Link> to_coarse;
   const Comm* comm = nullptr;
+  // where the launches ran when it was built: where the levels that are not
+  // on_host, and their transfers, are run (a Multigrid refuses another)
+  Space space = Space::host;
   // level l is the first whole level on several ranks: it and the coarser
   // ones are computed by rank 0 alone
   bool agglomerated(int l) const;
