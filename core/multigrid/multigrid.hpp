@@ -24,6 +24,13 @@
 // Every line above the exchanges and the reductions is the same for one
 // rank and many.
 //
+// Device: in a device run (one rank, kernels/launch.hpp) the levels after
+// the finest with fewer than device_min_nodes() nodes are held and run on
+// the host, where their sweeps cost less than GPU launches; the V-cycle
+// enters the first of them as it enters an agglomerated level: its
+// right-hand side crosses to the host, its correction back (a copy each a
+// V-cycle).
+//
 // Smoother: Chebyshev polynomial of degree `degree` in D^{-1}A (Jacobi),
 // targeting [lmax/range, lmax]; lmax from 15 steps of Jacobi-PCG (Lanczos)
 // in the V-cycle's precision, times 1.15, from a start vector that depends
