@@ -116,10 +116,13 @@ std::string rank_layout(const GridDims& g, const Comm& comm, const std::string& 
 }
 
 std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, index coarse_nodes, const Comm& comm,
-                                                          index min_nodes_per_rank, index device_min_nodes) {
+                                                          index min_nodes_per_rank,
+                                                          std::optional<index> device_min_nodes) {
   auto h = std::make_shared<GridHierarchy>();
   h->comm = &comm;
   h->space = launch_space();
+  const bool device = launch_on_device() && !comm.distributed();
+  const index host_below = !device ? 0 : device_min_nodes ? *device_min_nodes : tresca::device_min_nodes();
   std::vector<GridDims> grids;
   GridDims g = fine;
   for (;;) {
@@ -136,7 +139,7 @@ std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, 
     lv.distributed = !whole;
     lv.slab = lv.distributed ? make_slab(lv.grid, comm.rank(), comm.size()) : make_slab(lv.grid, 0, 1);
     // (nodes fall from level to level: once a level is on the host, so are the coarser ones)
-    lv.on_host = launch_on_device() && !comm.distributed() && l > 0 && lv.grid.nodes() < device_min_nodes;
+    lv.on_host = l > 0 && lv.grid.nodes() < host_below;
     h->levels.push_back(lv);
   }
   for (size_t l = 0; l + 1 < h->levels.size(); ++l) {

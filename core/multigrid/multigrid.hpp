@@ -64,6 +64,7 @@
 #include <Eigen/SparseCholesky>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -140,11 +141,12 @@ struct GridHierarchy {
   // split over comm's ranks where worth_distributing (Comm::self(): all
   // whole); with the launches on the device (one rank), the levels after
   // the finest with fewer than device_min_nodes nodes on the host, their
-  // transfers made there
+  // transfers made there (none given: tresca::device_min_nodes(), read in
+  // a device run only)
   static std::shared_ptr<const GridHierarchy> build(const GridDims& fine, index coarse_nodes,
                                                     const Comm& comm = Comm::self(),
                                                     index min_nodes_per_rank = kMinNodesPerRank,
-                                                    index device_min_nodes = tresca::device_min_nodes());
+                                                    std::optional<index> device_min_nodes = std::nullopt);
 };
 
 // The description of the operator a multigrid preconditions: its
