@@ -58,12 +58,13 @@ std::string device_description();
 // libgomp's own. Throws std::invalid_argument for any other value.
 int device_warps();
 
-// The smallest multigrid level the device runs (in nodes): in a device run
-// the coarser levels run on the host (GridHierarchy, core/multigrid), where
-// a sweep of a few ten thousand nodes costs about what one target region's
-// launch does (perf/RESULTS.md §0w), and their right-hand side and
-// correction cross once a V-cycle. From TRESCA_DEVICE_MIN_NODES (a count
-// >= 0; 0: every level on the device), read once; default 32768. Throws
+// In a device run, the multigrid levels (the finest aside) with fewer
+// nodes than this run on the host (GridHierarchy, core/multigrid): a host
+// sweep of a few ten thousand nodes is modelled to cost about what one
+// target region's launch does (perf/RESULTS.md §0w, to be measured on a
+// GPU); their right-hand side and correction cross once a V-cycle. From
+// TRESCA_DEVICE_MIN_NODES (a count >= 0; 0: every level on the device),
+// read once, in a device run only; default 32768. Throws
 // std::invalid_argument for any other value.
 index device_min_nodes();
 
