@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -81,29 +82,29 @@ void set_launch_on_device(bool on) {
   on_device = on;
 }
 
+namespace {
+// The integer setting in environment variable `name`: `fallback` where it
+// is unset or empty, else a whole number in [lo, hi], or std::invalid_argument
+// saying "NAME=value must be <what>"
+long long setting(const char* name, long long fallback, long long lo, long long hi, const char* what) {
+  const char* e = std::getenv(name);
+  if (e == nullptr || *e == '\0') return fallback;
+  char* end = nullptr;
+  const long long v = std::strtoll(e, &end, 10);
+  if (*end != '\0' || v < lo || v > hi)
+    throw std::invalid_argument(std::string(name) + "=" + e + " must be " + what);
+  return v;
+}
+}  // namespace
+
 int device_warps() {
-  static const int warps = [] {
-    const char* e = std::getenv("TRESCA_DEVICE_WARPS");
-    if (e == nullptr || *e == '\0') return 8;
-    char* end = nullptr;
-    const long w = std::strtol(e, &end, 10);
-    if (*end != '\0' || w < 1 || w > 32)
-      throw std::invalid_argument(std::string("TRESCA_DEVICE_WARPS=") + e + " must be a warp count in 1..32");
-    return int(w);
-  }();
+  static const int warps = int(setting("TRESCA_DEVICE_WARPS", 8, 1, 32, "a warp count in 1..32"));
   return warps;
 }
 
 index device_min_nodes() {
-  static const index nodes = [] {
-    const char* e = std::getenv("TRESCA_DEVICE_MIN_NODES");
-    if (e == nullptr || *e == '\0') return index(32768);
-    char* end = nullptr;
-    const long long n = std::strtoll(e, &end, 10);
-    if (*end != '\0' || n < 0)
-      throw std::invalid_argument(std::string("TRESCA_DEVICE_MIN_NODES=") + e + " must be a node count >= 0");
-    return index(n);
-  }();
+  static const index nodes = index(setting("TRESCA_DEVICE_MIN_NODES", 32768, 0,
+                                           std::numeric_limits<long long>::max(), "a node count >= 0"));
   return nodes;
 }
 
