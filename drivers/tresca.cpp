@@ -307,9 +307,11 @@ void show_progress(RunOptions& opt) {
     std::printf("  %s: %.2f s\n", phase, sec);
     std::fflush(stdout);
   };
-  opt.nested_done = [](const NestedLevel& l) {
-    std::printf("  nested: mesh %s solved in %d Newton steps%s: %.2f s\n", dims_string(l.spec).c_str(),
-                l.newton_iterations, l.converged ? "" : " (not converged: not used)", l.seconds);
+  opt.nested_done = [device_run = launch_on_device()](const NestedLevel& l) {
+    // (a device run solves its small coarser meshes on the host: say where)
+    std::printf("  nested: mesh %s solved in %d Newton steps%s%s: %.2f s\n", dims_string(l.spec).c_str(),
+                l.newton_iterations, !device_run ? "" : l.on_device ? " on the gpu" : " on the cpu",
+                l.converged ? "" : " (not converged: not used)", l.seconds);
     std::fflush(stdout);
   };
   opt.newton.progress = [](const NewtonProgress& p) {

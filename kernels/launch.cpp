@@ -420,7 +420,7 @@ void* device_scratch(std::size_t bytes) {
 std::string device_description() {
   if (!offload_built()) return "none (built without offload)";
   const int n = omp_get_num_devices();
-  const std::string teams = ", " + std::to_string(device_warps()) + " warps a team, multigrid levels under " +
+  const std::string teams = ", " + std::to_string(device_warps()) + " warps a team, multigrid levels and coarser meshes under " +
                             std::to_string(device_min_nodes()) + " nodes on the host";
   if (n == 0) return "none: target regions run on the host" + teams;
   return "device " + std::to_string(omp_get_default_device()) + " of " + std::to_string(n) + " (OpenMP offload)" + teams;

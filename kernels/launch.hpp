@@ -43,9 +43,9 @@ namespace tresca {
 bool launch_on_device();
 void set_launch_on_device(bool on);  // throws std::invalid_argument if the build has no offload
 bool offload_built();                // whether this build has TRESCA_OFFLOAD
-// "device 0 of 1 (OpenMP offload), 8 warps a team, multigrid levels under
-// 32768 nodes on the host", "none: target regions run on the host, 8 warps
-// a team, ..." or "none (built without offload)"
+// "device 0 of 1 (OpenMP offload), 8 warps a team, multigrid levels and
+// coarser meshes under 32768 nodes on the host", "none: target regions run
+// on the host, 8 warps a team, ..." or "none (built without offload)"
 std::string device_description();
 
 // Warps a team of every device launch: the thread_limit of its target region
@@ -58,11 +58,13 @@ std::string device_description();
 // libgomp's own. Throws std::invalid_argument for any other value.
 int device_warps();
 
-// In a device run, the multigrid levels (the finest aside) with fewer
-// nodes than this run on the host (GridHierarchy, core/multigrid): a host
-// sweep of a few ten thousand nodes is modelled to cost about what one
-// target region's launch does (perf/RESULTS.md §0w, to be measured on a
-// GPU); their right-hand side and correction cross once a V-cycle. From
+// In a device run, the multigrid levels (the finest aside) and the nested
+// iteration's coarser meshes with fewer nodes than this run on the host
+// (GridHierarchy, core/multigrid; solve_coarser_mesh, core/contact/run.cpp):
+// a host sweep of a few ten thousand nodes is modelled to cost about what
+// one target region's launch does (perf/RESULTS.md §0w, §0y; to be measured
+// on a GPU). A level's right-hand side and correction cross once a V-cycle,
+// a coarser mesh's solution once. From
 // TRESCA_DEVICE_MIN_NODES (a count >= 0; 0: every level on the device),
 // read once, in a device run only; default 32768. Throws
 // std::invalid_argument for any other value.

@@ -63,10 +63,18 @@ void solve_coarser_mesh(const ProblemSpec& spec, const RunOptions& opt, RunResul
   co.tight_rtol = std::max(opt.tight_rtol, 1e-3 * opt.nested_rtol);
   co.newton.residual_accuracy = std::max(opt.newton.residual_accuracy, 1e-3 * opt.nested_rtol);
   co.contact = coarse_conditions(R.problem->grid, R.contact, grid_of(cs));
-  RunResult C = run_tresca(cs, co);
+  // in a device run, a mesh under device_min_nodes() is solved on the host,
+  // as the multigrid's small levels are: a whole solve's thousands of
+  // launches would cost more than its work (perf/RESULTS.md §0y)
+  const bool on_device = launch_on_device() && cs.nodes() >= device_min_nodes();
+  RunResult C;
+  {
+    const HostLaunches where(!on_device);
+    C = run_tresca(cs, co);
+  }
   R.nested = C.nested;
   R.nested.push_back({cs, int(C.newton_steps()), C.converged(), C.fine_matvecs_total - C.nested_fine_matvecs,
-                      C.times.total - C.times.nested});
+                      C.times.total - C.times.nested, on_device});
   R.nested_fine_matvecs = C.fine_matvecs_total * double(cs.free_dofs()) / double(spec.free_dofs());
   if (opt.nested_done) opt.nested_done(R.nested.back());
   if (!C.converged()) return;

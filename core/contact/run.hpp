@@ -26,6 +26,7 @@ struct NestedLevel {
   bool converged = false;
   double fine_matvecs = 0;  // its own work (without coarser meshes), in matvecs of that mesh
   double seconds = 0;       // its own time (without coarser meshes)
+  bool on_device = false;   // where its launches ran (device_min_nodes(), kernels/launch.hpp)
 };
 
 // One Newton iterate of the fine mesh with the body's displacement, for

@@ -29,7 +29,8 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                       {"newton_iterations", l.newton_iterations},
                       {"converged", l.converged},
                       {"fine_matvecs_own", l.fine_matvecs},
-                      {"seconds", l.seconds}});
+                      {"seconds", l.seconds},
+                      {"device", l.on_device ? "gpu" : "cpu"}});
   const Obstacle& o = spec.obstacle;
   Json obstacle = {{"kind", to_string(o.kind)}, {"gap", o.gap}};
   if (o.kind == Obstacle::Kind::plane) {
