@@ -46,10 +46,11 @@ cat > "$out/run.sh" <<'RUN'
 #                   level-13 apply, V-cycle and vector benchmarks and a
 #                   level-12 contact solve with each (perf/offload_registers.py
 #                   predicts the occupancy of each; RESULTS.md §0n)
-#   run.sh cut      where the multigrid leaves the device (TRESCA_DEVICE_MIN_NODES
-#                   0, 8192, 32768, 131072, 524288: coarser levels on the
-#                   host): the level-10 and level-12 V-cycles and a level-12
-#                   contact solve with each (RESULTS.md §0w)
+#   run.sh cut      where the multigrid and the nested iteration leave the
+#                   device (TRESCA_DEVICE_MIN_NODES 0, 8192, 32768, 131072,
+#                   524288: smaller levels and coarser meshes on the host):
+#                   the level-10 and level-12 V-cycles and a level-12 contact
+#                   solve with each (RESULTS.md §0w, §0y)
 #   run.sh all      tests, bench, elastic, contact (about 10 minutes)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -111,7 +112,7 @@ if [[ $stage == cut ]]; then
     TRESCA_DEVICE_MIN_NODES=$m "$here/bench_kernels" --benchmark_filter='DeviceVCycle/(10|12)' \
       --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
     TRESCA_DEVICE_MIN_NODES=$m "$here/tresca" --level 12 --device gpu --profile --json "$out/cut_$m.json" |
-      grep -E '^times|host levels|^launches|on the device:'
+      grep -E 'nested:|^times|host levels|^launches|on the device:'
   done
 fi
 if [[ $stage == large ]]; then
