@@ -392,7 +392,7 @@ void print_header(const Command& c, const ThreadPlacement& placement, const Comm
                                      .c_str() : "");
   std::printf("        estimated peak memory %.2f GB%s; kernels: %s; %s\n",
               run_memory_per_rank(spec) / 1e9,
-              comm.distributed() ? " per rank" : "",
+              comm.distributed() ? " per rank" : launch_on_device() ? " (a device run: nearly all in the device's)" : "",
               build_info().c_str(), omp_wait_setting().c_str());
   std::printf("        %s; %s; kernels on %s\n", placement.describe().c_str(), huge_page_setting().c_str(),
               c.device.c_str());
@@ -457,8 +457,12 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
               N.outer_iterations, N.operator_applications);
   if (N.outer_limit_hits > 0)
     std::printf("note: %d Newton steps were taken with an outer CG stopped at its iteration limit\n", N.outer_limit_hits);
-  std::printf("work: %.1f fine-grid matvec equivalents per Newton step; peak memory %.2f GB%s\n",
-              R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9, comm.distributed() ? " (largest rank)" : "");
+  char device_peak[64] = "";
+  if (R.peak_device_memory > 0)
+    std::snprintf(device_peak, sizeof device_peak, ", device Fields at most %.2f GB", R.peak_device_memory / 1e9);
+  std::printf("work: %.1f fine-grid matvec equivalents per Newton step; peak memory %.2f GB%s%s\n",
+              R.fine_matvecs_per_newton_step(), R.peak_memory / 1e9, comm.distributed() ? " (largest rank)" : "",
+              device_peak);
   std::printf("times [s]: nested %.3f, setup %.3f, condense %.3f, solve %.3f, recover %.3f, total %.3f\n",
               R.times.nested, R.times.setup, R.times.condense, R.times.solve, R.times.recover, R.times.total);
   if (comm.distributed()) {

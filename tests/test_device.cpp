@@ -472,6 +472,10 @@ TEST(Device, ContactSolveOnTheDeviceMatchesTheHost) {
     EXPECT_EQ(d.report.status, h.report.status) << c.what;
     // the results are host values
     EXPECT_FALSE(d.u_full.on_device()) << c.what;
+    // what the device's Fields held at most is reported (at least the fine
+    // mesh's 3D vectors of the V-cycle and the inner CG), a CPU run's is 0
+    EXPECT_GE(d.peak_device_memory, 4.0 * 3 * double(spec.nodes()) * sizeof(real)) << c.what;
+    EXPECT_EQ(h.peak_device_memory, 0.0) << c.what;
     if (c.recover) {
       const std::vector<real> hu = h.u_full.to_vector();
       EXPECT_LE(test::max_abs_diff(d.u_full.to_vector(), hu), 1e-10 * test::max_abs(hu)) << c.what;

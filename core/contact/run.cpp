@@ -342,6 +342,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.fine_matvecs_total = R.nested_fine_matvecs + R.newton_fine_matvecs() + S.apply_work(cond.iterations) +
                          S.apply_work(R.report.inner.iterations) + R.choice_fine_matvecs;
   R.peak_memory = Comm::world().max(peak_memory_bytes());  // several ranks: the largest rank's
+  R.peak_device_memory = launch_on_device() ? block_reuse(Space::device).peak_bytes : 0;
 
   // A failed Coulomb Newton solve is redone as the fixed point of Tresca
   // solves (each globalised by the line search), its work and time added to

@@ -118,6 +118,7 @@ struct RunResult {
   // check (which includes the recovery)
   double fine_matvecs_total = 0;
   double peak_memory = 0;  // bytes, process peak resident set after the run (several ranks: the largest)
+  double peak_device_memory = 0;  // bytes, the most the device's Fields held so far (a device run; else 0)
   // the coarse meshes of nested iteration, coarsest first (empty: cold start);
   // fine_matvecs_total includes their work, scaled by their share of the dofs
   std::vector<NestedLevel> nested;

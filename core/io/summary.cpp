@@ -148,6 +148,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["nested"] = nested;
   j["coulomb"] = coulomb;
   j["peak_memory_bytes"] = R.peak_memory;
+  j["peak_device_bytes"] = R.peak_device_memory;
   return j;
 }
 
