@@ -64,10 +64,9 @@ int device_warps();
 // a host sweep of a few ten thousand nodes is modelled to cost about what
 // one target region's launch does (perf/RESULTS.md §0w, §0y; to be measured
 // on a GPU). A level's right-hand side and correction cross once a V-cycle,
-// a coarser mesh's solution once. From
-// TRESCA_DEVICE_MIN_NODES (a count >= 0; 0: every level on the device),
-// read once, in a device run only; default 32768. Throws
-// std::invalid_argument for any other value.
+// a coarser mesh's solution once. From TRESCA_DEVICE_MIN_NODES (a count
+// >= 0; 0: every level and mesh on the device), read once, in a device run
+// only; default 32768. Throws std::invalid_argument for any other value.
 index device_min_nodes();
 
 // Launches (and new Fields) are the host's inside this scope, and where
