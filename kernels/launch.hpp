@@ -54,7 +54,10 @@ std::string device_description();
 // hold at once: floor(registers an SM / (registers a thread x 32 x warps)) a
 // multiprocessor, so fewer warps a team can fit more warps an SM where the
 // kernels' register count is not a divisor (perf/offload_registers.py,
-// RESULTS.md §0n). From TRESCA_DEVICE_WARPS (1..32), read once; default 8,
+// RESULTS.md §0n). A thread's registers are those of the heaviest body in
+// the kernel's device image: this file's launch.cpp and the vector kernels
+// are a shared library of their own in an offload build, an image apart
+// from the apply's (CMakeLists.txt, tresca_launch; RESULTS.md §0z). From TRESCA_DEVICE_WARPS (1..32), read once; default 8,
 // libgomp's own. Throws std::invalid_argument for any other value.
 int device_warps();
 

@@ -86,6 +86,9 @@ void scale(index n, real a, real* y) {
 void hadamard(index n, const real* d, const real* x, real* y) {
   for_each_entry(n, kHadamardCost, [=](index i) { y[i] = d[i] * x[i]; });
 }
+void triad(index n, const real* b, real s, const real* c, real* a) {
+  for_each_entry(n, kTriadCost, [=](index i) { a[i] = b[i] + s * c[i]; });
+}
 
 namespace {
 // body(k) at entry k of each of the three runs, one launch
@@ -132,9 +135,10 @@ real cg_update(index n, real a, const real* p, const real* q, real* x, real* r) 
     }
     return s;
   }, [=](index i) {
+    const real ri = r[i] - a * q[i];
+    r[i] = ri;
     x[i] += a * p[i];
-    r[i] -= a * q[i];
-    return r[i] * r[i];
+    return ri * ri;
   });
 }
 

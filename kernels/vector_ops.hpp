@@ -5,7 +5,7 @@
 // bitwise identical for any thread count.
 //
 // Cost models (bytes moved, flops), n entries of 8 bytes:
-//   dot 16n B, 2n F;  axpy 24n B, 2n F;  xpay 24n B, 2n F;
+//   dot 16n B, 2n F;  axpy 24n B, 2n F;  xpay 24n B, 2n F;  triad 24n B, 2n F;
 //   cg_update (x += a p, r -= a q, returns r.r) 48n B, 6n F;
 //   cheb_update (d = s d + t Dinv r, x += d) 40n B, 5n F;
 //   cheb_first (d = t Dinv b, x = d) 32n B, 2n F; (..., x += d) 40n B, 3n F;
@@ -22,7 +22,7 @@ constexpr index kDotBlock = 4096;
 // per entry (the table above)
 constexpr Cost kDotCost{16, 2}, kAxpyCost{24, 2}, kXpayCost{24, 2}, kCgUpdateCost{48, 6}, kChebUpdateCost{40, 5},
     kChebFirstCost{32, 2}, kChebFirstOnGuessCost{40, 3}, kCopyCost{16, 0}, kFillCost{8, 0}, kScaleCost{16, 1},
-    kHadamardCost{24, 1}, kJacobiCgUpdateCost{32, 5}, kJacobiXpayCost{32, 3};
+    kHadamardCost{24, 1}, kTriadCost{24, 2}, kJacobiCgUpdateCost{32, 5}, kJacobiXpayCost{32, 3};
 
 template <class T>
 real dot(index n, const T* x, const T* y);  // T = double, float
@@ -38,6 +38,7 @@ template <class To, class From>
 void convert(index n, const From* x, To* y);               // y = To(x) (double <-> float)
 void scale(index n, real a, real* y);                      // y *= a
 void hadamard(index n, const real* d, const real* x, real* y);  // y = d .* x
+void triad(index n, const real* b, real s, const real* c, real* a);  // a = b + s c (STREAM's triad)
 // The same on the three component blocks of a vector of N nodes (layout
 // c N + node), entries [first, first + count) of each, in one launch: a
 // plane of a 3D vector (core/contact/steklov.cpp), a launch where three

@@ -24,6 +24,7 @@ cmake --build "$build" -j "$(nproc)" --target test_device bench_kernels tresca e
 rm -rf "$out"
 mkdir -p "$out/lib"
 cp "$build"/bin/test_device "$build"/bin/bench_kernels "$build"/bin/tresca "$build"/bin/elastic "$build"/bin/roofline "$out"/
+cp "$build"/lib/libtresca_launch.so "$out/lib/"  # (the vector kernels' device image, CMakeLists.txt)
 lib=/usr/lib/x86_64-linux-gnu
 cp -L "$lib"/libgomp.so.1 "$lib"/libgomp-plugin-nvptx.so.1 "$out/lib/"
 cp -L "$(ldconfig -p | awk '/libbenchmark\.so\./ {print $NF; exit}')" "$out/lib/"
@@ -42,10 +43,10 @@ cat > "$out/run.sh" <<'RUN'
 #                   level 10: the contact values' largest difference relative
 #                   to their largest value (issue 22: <= 1e-10)
 #   run.sh large    tresca --device gpu at levels 13, 14 and 15
-#   run.sh warps    the team size (TRESCA_DEVICE_WARPS 1, 2, 4, 8): the
+#   run.sh warps    the team size (TRESCA_DEVICE_WARPS 1, 2, 4, 8, 16): the
 #                   level-13 apply, V-cycle and vector benchmarks and a
 #                   level-12 contact solve with each (perf/offload_registers.py
-#                   predicts the occupancy of each; RESULTS.md §0n)
+#                   predicts the occupancy of each image; RESULTS.md §0n, §0z)
 #   run.sh cut      where the multigrid and the nested iteration leave the
 #                   device (TRESCA_DEVICE_MIN_NODES 0, 8192, 32768, 131072,
 #                   524288: smaller levels and coarser meshes on the host):
@@ -99,7 +100,7 @@ if [[ $stage == contact || $stage == all ]]; then
   contact 10 --coulomb 0.8
 fi
 if [[ $stage == warps ]]; then
-  for w in 1 2 4 8; do
+  for w in 1 2 4 8 16; do
     echo "== TRESCA_DEVICE_WARPS=$w"
     TRESCA_DEVICE_WARPS=$w "$here/bench_kernels" --benchmark_filter='Device(Apply|ApplyFloat|VCycle)/13|Device(Dot|CgUpdate)/134217728' \
       --benchmark_repetitions=3 --benchmark_report_aggregates_only=true

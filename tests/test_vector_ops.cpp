@@ -268,6 +268,17 @@ TEST(VectorOps, ChebyshevUpdatesFollowTheirFormulas) {
   }
 }
 
+// STREAM's triad (the roofline's and scaling's bandwidth reference), on the
+// awkward lengths
+TEST(VectorOps, TriadFollowsItsFormula) {
+  for (index n : kLengths) {
+    const auto b = test::random_vector(n, 13), c = test::random_vector(n, 14);
+    std::vector<real> a(n, std::nan(""));
+    triad(n, b.data(), -1.75, c.data(), a.data());
+    for (index i = 0; i < n; ++i) ASSERT_NEAR(a[i], b[i] - 1.75 * c[i], 1e-15) << "n = " << n << ", " << i;
+  }
+}
+
 // the three component blocks' runs in one launch: the plain loops' values
 // there, every other entry untouched (N, first, count awkward: runs that
 // begin mid-block, a run to the block's end, an empty one)

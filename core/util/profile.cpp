@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "kernels/launch.hpp"
+#include "kernels/vector_ops.hpp"
 
 namespace tresca {
 
@@ -33,19 +34,15 @@ double wall_time() { return omp_get_wtime(); }
 double triad_bandwidth(index n, int reps) {
   Field<real> a(n), b(n), c(n);  // (first touched here, by one thread: one NUMA node assumed)
   real *pa = a.data(), *pb = b.data(), *pc = c.data();
-  constexpr Cost kTriad{24, 2};
-  for_each_entry(n, kTriad, [=](index i) {
-    pb[i] = 1;
-    pc[i] = 2;
-  });
-  const real s = 3;
-  auto triad = [&] { for_each_entry(n, kTriad, [=](index i) { pa[i] = pb[i] + s * pc[i]; }); };
-  triad();  // warm-up
-  const double t = best_time(reps, triad);
+  fill(n, real(1), pb);
+  fill(n, real(2), pc);
+  auto run = [&] { triad(n, pb, 3, pc, pa); };
+  run();  // warm-up
+  const double t = best_time(reps, run);
   real mid = 0;  // (a may live on the device)
   space_copy(Space::host, &mid, a.space(), pa + n / 2, sizeof(real));
   if (mid != 7) throw std::runtime_error("triad_bandwidth: the triad computed a wrong value");
-  return 24.0 * double(n) / t;
+  return kTriadCost.bytes * double(n) / t;
 }
 
 double peak_memory_bytes() {
