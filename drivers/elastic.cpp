@@ -37,10 +37,10 @@ int main(int argc, char** argv) {
     Args a(argc, argv, {"--level", "--dims", "--E", "--nu", "--rtol", "--threads", "--device"}, {});
     if (answered_help_or_version(a, "elastic", kHelp)) return 0;
     const int threads = apply_threads(a);
+    const std::string device = apply_device(a, comm);  // (before the spec: its memory check knows a device run)
     const ProblemSpec spec = spec_from_args(a, 6);
     const real rtol = a.real_value("--rtol", 1e-10);
     if (!(rtol > 0 && rtol < 1)) throw std::invalid_argument("--rtol " + a.str("--rtol") + " must lie in (0,1)");
-    const std::string device = apply_device(a, comm);
     warn_if_cores_busy();
     const double t0 = wall_time();
     const Problem P = make_problem(spec);  // every rank builds the whole load

@@ -1,5 +1,6 @@
 #include "launch.hpp"
 
+#include <dlfcn.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -9,6 +10,7 @@
 #include <memory>
 #include <mutex>
 
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -417,13 +419,52 @@ void* device_scratch(std::size_t bytes) {
   return p;
 }
 
+namespace {
+// The default device's name and memory from the CUDA driver API. libgomp
+// numbers the nvptx devices as CUDA does (the only offload target built),
+// so OpenMP's default device is CUDA's ordinal of that number. Four stable
+// entry points, looked up by name: CUresult is an int, CUdevice an int.
+DeviceInfo ask_cuda_driver(int ordinal) {
+  DeviceInfo info;
+  void* cuda = dlopen("libcuda.so.1", RTLD_LAZY | RTLD_LOCAL);
+  if (!cuda) return info;
+  using Init = int (*)(unsigned);
+  using Get = int (*)(int*, int);
+  using Name = int (*)(char*, int, int);
+  using TotalMem = int (*)(std::size_t*, int);
+  const auto init = reinterpret_cast<Init>(dlsym(cuda, "cuInit"));
+  const auto get = reinterpret_cast<Get>(dlsym(cuda, "cuDeviceGet"));
+  const auto name = reinterpret_cast<Name>(dlsym(cuda, "cuDeviceGetName"));
+  const auto total = reinterpret_cast<TotalMem>(dlsym(cuda, "cuDeviceTotalMem_v2"));
+  int dev = 0;
+  char text[256] = {};
+  std::size_t bytes = 0;
+  if (init && get && name && total && init(0) == 0 && get(&dev, ordinal) == 0) {
+    if (name(text, int(sizeof text) - 1, dev) == 0) info.name = text;
+    if (total(&bytes, dev) == 0) info.memory_bytes = double(bytes);
+  }
+  dlclose(cuda);
+  return info;
+}
+}  // namespace
+
+DeviceInfo device_info() {
+  if (!offload_built() || omp_get_num_devices() == 0) return {};
+  static const DeviceInfo info = ask_cuda_driver(omp_get_default_device());
+  return info;
+}
+
 std::string device_description() {
   if (!offload_built()) return "none (built without offload)";
   const int n = omp_get_num_devices();
   const std::string teams = ", " + std::to_string(device_warps()) + " warps a team, multigrid levels and coarser meshes under " +
                             std::to_string(device_min_nodes()) + " nodes on the host";
   if (n == 0) return "none: target regions run on the host" + teams;
-  return "device " + std::to_string(omp_get_default_device()) + " of " + std::to_string(n) + " (OpenMP offload)" + teams;
+  const DeviceInfo info = device_info();
+  char what[320] = "";
+  if (!info.name.empty()) std::snprintf(what, sizeof what, ": %s, %.1f GB", info.name.c_str(), info.memory_bytes / 1e9);
+  return "device " + std::to_string(omp_get_default_device()) + " of " + std::to_string(n) + " (OpenMP offload" + what +
+         ")" + teams;
 }
 
 }  // namespace tresca

@@ -43,10 +43,19 @@ namespace tresca {
 bool launch_on_device();
 void set_launch_on_device(bool on);  // throws std::invalid_argument if the build has no offload
 bool offload_built();                // whether this build has TRESCA_OFFLOAD
-// "device 0 of 1 (OpenMP offload), 8 warps a team, multigrid levels and
-// coarser meshes under 32768 nodes on the host", "none: target regions run
+// "device 0 of 1 (OpenMP offload: NVIDIA H100 80GB HBM3, 85.0 GB), 8 warps
+// a team, multigrid levels and coarser meshes under 32768 nodes on the host", "none: target regions run
 // on the host, 8 warps a team, ..." or "none (built without offload)"
 std::string device_description();
+// The GPU's name and memory ("NVIDIA H100 80GB HBM3", 85e9 bytes), asked of
+// the CUDA driver that libgomp's nvptx plugin runs on (libcuda.so.1, opened
+// at run time: no link to it) for the default device; empty and 0 where no
+// device is present, the build has no offload or the driver does not answer.
+struct DeviceInfo {
+  std::string name;
+  double memory_bytes = 0;
+};
+DeviceInfo device_info();
 
 // Warps a team of every device launch: the thread_limit of its target region
 // (GCC's nvptx backend maps an OpenMP thread to a warp, its simd lanes to the

@@ -21,10 +21,19 @@ mkdir -p "$build"
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DTRESCA_OFFLOAD=ON -DCMAKE_CXX_COMPILER=g++-12 \
       -DTRESCA_MPI=OFF -DTRESCA_NATIVE=OFF -DTRESCA_ARCH=x86-64-v3 > "$build/configure.log"
 cmake --build "$build" -j "$(nproc)" --target test_device bench_kernels tresca elastic roofline > "$build/build.log"
+# bench_kernels once more with the vector kernels in the program's device
+# image (TRESCA_LAUNCH_LIBRARY=STATIC), for run.sh images
+one="$build-one-image"
+mkdir -p "$one"
+cmake -S . -B "$one" -DCMAKE_BUILD_TYPE=Release -DTRESCA_OFFLOAD=ON -DCMAKE_CXX_COMPILER=g++-12 \
+      -DTRESCA_MPI=OFF -DTRESCA_NATIVE=OFF -DTRESCA_ARCH=x86-64-v3 -DTRESCA_LAUNCH_LIBRARY=STATIC > "$one/configure.log"
+cmake --build "$one" -j "$(nproc)" --target bench_kernels > "$one/build.log"
 rm -rf "$out"
 mkdir -p "$out/lib"
 cp "$build"/bin/test_device "$build"/bin/bench_kernels "$build"/bin/tresca "$build"/bin/elastic "$build"/bin/roofline "$out"/
 cp "$build"/lib/libtresca_launch.so "$out/lib/"  # (the vector kernels' device image, CMakeLists.txt)
+mkdir -p "$out/one-image"
+cp "$one"/bin/bench_kernels "$out/one-image/"
 lib=/usr/lib/x86_64-linux-gnu
 cp -L "$lib"/libgomp.so.1 "$lib"/libgomp-plugin-nvptx.so.1 "$out/lib/"
 cp -L "$(ldconfig -p | awk '/libbenchmark\.so\./ {print $NF; exit}')" "$out/lib/"
@@ -52,6 +61,10 @@ cat > "$out/run.sh" <<'RUN'
 #                   524288: smaller levels and coarser meshes on the host):
 #                   the level-10 and level-12 V-cycles and a level-12 contact
 #                   solve with each (RESULTS.md §0w, §0y)
+#   run.sh images   the vector kernels in a device image of their own (this
+#                   build: libtresca_launch.so) against in the program's
+#                   (one-image/bench_kernels), alternating: axpy, dot, the CG
+#                   update and the level-12 V-cycle (RESULTS.md §0z)
 #   run.sh all      tests, bench, elastic, contact (about 10 minutes)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -114,6 +127,15 @@ if [[ $stage == cut ]]; then
       --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
     TRESCA_DEVICE_MIN_NODES=$m "$here/tresca" --level 12 --device gpu --profile --json "$out/cut_$m.json" |
       grep -E 'nested:|^times|host levels|^launches|on the device:'
+  done
+fi
+if [[ $stage == images ]]; then
+  for round in 1 2; do
+    for b in "$here" "$here/one-image"; do
+      echo "== $b/bench_kernels (round $round)"
+      "$b/bench_kernels" --benchmark_filter='Device(Axpy|Dot|CgUpdate)/(1024|134217728)|DeviceVCycle/12' \
+        --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+    done
   done
 fi
 if [[ $stage == large ]]; then

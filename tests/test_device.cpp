@@ -54,6 +54,22 @@ TEST(Device, PresentWhereRequired) {
   EXPECT_GT(omp_get_num_devices(), 0) << "no offload device: " << device_description();
 }
 
+// the GPU a device run names (the run's header, JSON and bench_kernels'
+// context) and whose memory its memory check holds it to: the CUDA
+// driver's answer where a GPU is present, nothing elsewhere
+TEST(Device, NamesTheGpuAndItsMemory) {
+  const DeviceInfo d = device_info();
+  if (omp_get_num_devices() == 0) {
+    EXPECT_TRUE(d.name.empty());
+    EXPECT_EQ(d.memory_bytes, 0);
+    EXPECT_EQ(device_description().find("OpenMP offload"), std::string::npos) << device_description();
+    GTEST_SKIP() << "no GPU: nothing to name (" << device_description() << ")";
+  }
+  EXPECT_FALSE(d.name.empty());
+  EXPECT_GT(d.memory_bytes, 1e9);
+  EXPECT_NE(device_description().find(": " + d.name + ", "), std::string::npos) << device_description();
+}
+
 TEST(Device, WithoutOffloadTheDeviceIsRefused) {
   if (offload_built()) GTEST_SKIP() << "an offload build: " << device_description();
   EXPECT_THROW(set_launch_on_device(true), std::invalid_argument);

@@ -209,15 +209,22 @@ void check_memory(const ProblemSpec& s) {
   const double per_rank = run_memory_per_rank(s), need = per_rank * on_host;
   const auto [have, whose] = memory_limit();
   const bool short_here = have > 0 && need > 0.9 * have;
+  std::ostringstream os;
+  if (s.level >= 0) os << "level " << s.level << " (";
+  os << "mesh " << dims_string(s) << (s.level >= 0 ? ")" : "") << " needs about ";
   if (comm.max(short_here ? 1.0 : 0.0) > 0) {
-    std::ostringstream os;
-    if (s.level >= 0) os << "level " << s.level << " (";
-    os << "mesh " << dims_string(s) << (s.level >= 0 ? ")" : "") << " needs about ";
     if (comm.distributed())
       os << per_rank / 1e9 << " GB per rank on " << comm.size() << " ranks, " << need / 1e9 << " GB for the " << on_host
          << " ranks of one machine, more than " << whose << " " << have / 1e9 << " GB";
     else
       os << need / 1e9 << " GB, more than " << whose << " " << have / 1e9 << " GB";
+    fail(os.str());
+  }
+  // a device run (one rank) holds nearly all of it in the GPU's memory
+  const DeviceInfo gpu = launch_on_device() ? device_info() : DeviceInfo{};
+  if (gpu.memory_bytes > 0 && per_rank > 0.9 * gpu.memory_bytes) {
+    os << per_rank / 1e9 << " GB, nearly all on the device, more than the " << gpu.name << "'s "
+       << gpu.memory_bytes / 1e9 << " GB";
     fail(os.str());
   }
 }
