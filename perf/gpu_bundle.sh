@@ -65,6 +65,12 @@ cat > "$out/run.sh" <<'RUN'
 #                   build: libtresca_launch.so) against in the program's
 #                   (one-image/bench_kernels), alternating: axpy, dot, the CG
 #                   update and the level-12 V-cycle (RESULTS.md §0z)
+#   run.sh why      why a kernel runs as fast as it does (issue 22, item 6):
+#                   the launch geometry libgomp picks for each kernel
+#                   (GOMP_DEBUG=1: teams, warps) and, where Nsight Compute is
+#                   installed, its report on the apply (double, float), axpy,
+#                   dot and the CG update: registers, occupancy, waves,
+#                   memory throughput (ncu --clock-control none)
 #   run.sh all      tests, bench, elastic, contact (about 10 minutes)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -94,6 +100,11 @@ contact() {  # level, then tresca options
   echo "level $level $*: GPU against CPU: $(compare "$out/gpu_$level.csv" "$out/cpu_$level.csv")"
 }
 stage=${1:-all}
+case $stage in
+  tests|bench|elastic|contact|large|warps|cut|images|why|all) ;;
+  *) echo "run.sh: unknown stage '$stage' (tests, bench, elastic, contact, large, warps, cut, images, why, all)" >&2
+     exit 2 ;;
+esac
 if [[ $stage == tests || $stage == all ]]; then
   "$here/test_device"
 fi
@@ -137,6 +148,24 @@ if [[ $stage == images ]]; then
         --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
     done
   done
+fi
+if [[ $stage == why ]]; then
+  filter='Device(Apply|ApplyFloat)/12|Device(Axpy|Dot|CgUpdate)/16777216'
+  echo "== launches as libgomp makes them (count, kernel, geometry)"
+  GOMP_DEBUG=1 "$here/bench_kernels" --benchmark_filter="$filter" --benchmark_min_time=0.01 2>&1 |
+    sed -nE 's/.*kernel ([^:]*): launch (.*)/\1 \2/p' | sort | uniq -c | sort -rn | head -30
+  ncu=$(command -v ncu || ls /opt/nvidia/nsight-compute/*/ncu 2>/dev/null | head -1 || true)
+  if [[ -z $ncu ]]; then
+    echo "no ncu (Nsight Compute): no kernel reports"
+  else
+    for k in 'elasticity_apply_rowsIdE' 'elasticity_apply_rowsIfE' 'NS_4axpyE' 'NS_3dotIdEE' 'NS_9cg_updateE'; do
+      echo "== ncu: the first kernel whose mangled name matches $k"
+      "$ncu" --clock-control none --kernel-name-base mangled --kernel-name "regex:$k" --launch-skip 2 --launch-count 1 \
+        --section SpeedOfLight --section Occupancy --section LaunchStats --section MemoryWorkloadAnalysis \
+        "$here/bench_kernels" --benchmark_filter="$filter" --benchmark_min_time=0.01 2>&1 |
+        grep -vE '^(Device|-----|Benchmark|Run on|CPU Caches|  L[123]|Load Average|\*\*\*)' | head -80
+    done
+  fi
 fi
 if [[ $stage == large ]]; then
   for level in 13 14 15; do
