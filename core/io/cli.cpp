@@ -223,8 +223,8 @@ void check_memory(const ProblemSpec& s) {
   // a device run (one rank) holds nearly all of it in the GPU's memory
   const DeviceInfo gpu = launch_on_device() ? device_info() : DeviceInfo{};
   if (gpu.memory_bytes > 0 && per_rank > 0.9 * gpu.memory_bytes) {
-    os << per_rank / 1e9 << " GB, nearly all on the device, more than the " << gpu.name << "'s "
-       << gpu.memory_bytes / 1e9 << " GB";
+    os << per_rank / 1e9 << " GB, nearly all on the device, more than the "
+       << (gpu.name.empty() ? std::string("device") : gpu.name) << "'s " << gpu.memory_bytes / 1e9 << " GB";
     fail(os.str());
   }
 }
