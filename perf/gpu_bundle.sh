@@ -5,7 +5,8 @@
 # root:
 #   bash perf/gpu_bundle.sh [bundle-dir]          (default .gpu-bundle, git-ignored)
 # then, on the GPU machine, from the project root of the copy that travelled:
-#   bash .gpu-bundle/run.sh [tests|bench|elastic|contact|large|all]
+#   bash .gpu-bundle/run.sh [STAGE]      (the stages: run.sh's own header)
+# where OUT is set, each stage's log and files also land in $OUT.
 # which runs the device tests, the Device* benchmarks (BENCH=regex), roofline
 # --device gpu at level 13, the elastic and the contact solves with --device
 # gpu against the host's, and the large levels (run.sh's own header).
@@ -76,7 +77,24 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export OMP_TARGET_OFFLOAD=${OMP_TARGET_OFFLOAD:-MANDATORY} TRESCA_REQUIRE_DEVICE=1
-out=${OUT:-/tmp}
+stage=${1:-all}
+case $stage in
+  tests|bench|elastic|contact|large|warps|cut|images|why|all) ;;
+  *) echo "run.sh: unknown stage '$stage' (tests, bench, elastic, contact, large, warps, cut, images, why, all)" >&2
+     exit 2 ;;
+esac
+out=${TMPDIR:-/tmp}/tresca-gpu-run/$stage  # the stage's CSV and JSON files
+mkdir -p "$out"
+# Where OUT is set (the test machine's tool brings back what is under it):
+# the stage's output also goes to $OUT/run_STAGE.log, and its CSV and JSON
+# files to $OUT/run_STAGE.files.tgz, two files a stage (the tool returns 8)
+if [[ -n ${OUT:-} && -z ${RUN_SH_LOGGED:-} ]]; then
+  set +e
+  RUN_SH_LOGGED=1 bash "$0" "$stage" 2>&1 | tee "$OUT/run_$stage.log"
+  rc=${PIPESTATUS[0]}
+  tar czf "$OUT/run_$stage.files.tgz" -C "$out" .
+  exit "$rc"
+fi
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader 2>/dev/null || echo "no nvidia-smi"
 # largest |a - b| over the columns ux, uy, uz, lambda of two contact CSVs,
 # relative to the largest |a| of each column
@@ -99,12 +117,6 @@ contact() {  # level, then tresca options
   done
   echo "level $level $*: GPU against CPU: $(compare "$out/gpu_$level.csv" "$out/cpu_$level.csv")"
 }
-stage=${1:-all}
-case $stage in
-  tests|bench|elastic|contact|large|warps|cut|images|why|all) ;;
-  *) echo "run.sh: unknown stage '$stage' (tests, bench, elastic, contact, large, warps, cut, images, why, all)" >&2
-     exit 2 ;;
-esac
 if [[ $stage == tests || $stage == all ]]; then
   "$here/test_device"
 fi

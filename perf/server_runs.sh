@@ -27,6 +27,12 @@
 set -euo pipefail
 b=${1:?usage: bash perf/server_runs.sh BUILD STAGE}
 stage=${2:?usage: bash perf/server_runs.sh BUILD STAGE}
+# where OUT is set (the test machine's tool brings back what is under it),
+# the stage's output also goes to $OUT/server_STAGE.log
+if [[ -n ${OUT:-} && -z ${SERVER_RUNS_LOGGED:-} ]]; then
+  SERVER_RUNS_LOGGED=1 bash "$0" "$@" 2>&1 | tee "$OUT/server_$stage.log"
+  exit "${PIPESTATUS[0]}"
+fi
 T=${THREADS:-$(nproc)}
 L=${LEVEL:-12} LS=${LEVELS:-10-12}  # (smaller ones try the script out on a small machine)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1  # (the test machine runs as root)
