@@ -44,8 +44,9 @@ bool launch_on_device();
 void set_launch_on_device(bool on);  // throws std::invalid_argument if the build has no offload
 bool offload_built();                // whether this build has TRESCA_OFFLOAD
 // "device 0 of 1 (OpenMP offload: NVIDIA H100 80GB HBM3, 85.0 GB), 8 warps
-// a team, multigrid levels and coarser meshes under 32768 nodes on the host", "none: target regions run
-// on the host, 8 warps a team, ..." or "none (built without offload)"
+// a team, multigrid levels and coarser meshes under 32768 nodes on the
+// host", "none: target regions run on the host, 8 warps a team, ..." or
+// "none (built without offload)"
 std::string device_description();
 // The GPU's name and memory ("NVIDIA H100 80GB HBM3", 85e9 bytes), asked of
 // the CUDA driver that libgomp's nvptx plugin runs on (libcuda.so.1, opened
@@ -66,8 +67,9 @@ DeviceInfo device_info();
 // RESULTS.md §0n). A thread's registers are those of the heaviest body in
 // the kernel's device image: this file's launch.cpp and the vector kernels
 // are a shared library of their own in an offload build, an image apart
-// from the apply's (CMakeLists.txt, tresca_launch; RESULTS.md §0z). From TRESCA_DEVICE_WARPS (1..32), read once; default 8,
-// libgomp's own. Throws std::invalid_argument for any other value.
+// from the apply's (CMakeLists.txt, tresca_launch; RESULTS.md §0z). From
+// TRESCA_DEVICE_WARPS (1..32), read once; default 8, libgomp's own. Throws
+// std::invalid_argument for any other value.
 int device_warps();
 
 // In a device run, the multigrid levels (the finest aside) and the nested

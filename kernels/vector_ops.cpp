@@ -135,10 +135,9 @@ real cg_update(index n, real a, const real* p, const real* q, real* x, real* r) 
     }
     return s;
   }, [=](index i) {
-    const real ri = r[i] - a * q[i];
-    r[i] = ri;
     x[i] += a * p[i];
-    return ri * ri;
+    r[i] -= a * q[i];
+    return r[i] * r[i];
   });
 }
 
