@@ -18,16 +18,16 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-.gpu-bundle}
 build=${BUILD_DIR:-build-gpu-bundle}
+configure=(-DCMAKE_BUILD_TYPE=Release -DTRESCA_OFFLOAD=ON -DCMAKE_CXX_COMPILER=g++-12
+           -DTRESCA_MPI=OFF -DTRESCA_NATIVE=OFF -DTRESCA_ARCH=x86-64-v3)
 mkdir -p "$build"
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DTRESCA_OFFLOAD=ON -DCMAKE_CXX_COMPILER=g++-12 \
-      -DTRESCA_MPI=OFF -DTRESCA_NATIVE=OFF -DTRESCA_ARCH=x86-64-v3 > "$build/configure.log"
+cmake -S . -B "$build" "${configure[@]}" > "$build/configure.log"
 cmake --build "$build" -j "$(nproc)" --target test_device bench_kernels tresca elastic roofline > "$build/build.log"
 # bench_kernels once more with the vector kernels in the program's device
 # image (TRESCA_LAUNCH_LIBRARY=STATIC), for run.sh images
 one="$build-one-image"
 mkdir -p "$one"
-cmake -S . -B "$one" -DCMAKE_BUILD_TYPE=Release -DTRESCA_OFFLOAD=ON -DCMAKE_CXX_COMPILER=g++-12 \
-      -DTRESCA_MPI=OFF -DTRESCA_NATIVE=OFF -DTRESCA_ARCH=x86-64-v3 -DTRESCA_LAUNCH_LIBRARY=STATIC > "$one/configure.log"
+cmake -S . -B "$one" "${configure[@]}" -DTRESCA_LAUNCH_LIBRARY=STATIC > "$one/configure.log"
 cmake --build "$one" -j "$(nproc)" --target bench_kernels > "$one/build.log"
 rm -rf "$out"
 mkdir -p "$out/lib"
