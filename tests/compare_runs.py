@@ -5,8 +5,10 @@ largest magnitude, the same contact and stick sets, and the same Newton
 iteration count in the JSON summaries.
 
 With "mixed": the case must have separated, sticking and sliding nodes.
+With "krylov": the same Krylov iterations too (all of the Newton steps' CG
+and all of the inner K_ii CG).
 
-usage: compare_runs.py A.csv A.json B.csv B.json RTOL [mixed]"""
+usage: compare_runs.py A.csv A.json B.csv B.json RTOL [mixed] [krylov]"""
 import csv
 import json
 import sys
@@ -32,7 +34,8 @@ def main():
         same = all(x[col] == y[col] for x, y in zip(a, b))
         print(f"{col} sets equal: {same}")
         ok = ok and same
-    if len(sys.argv) > 6 and sys.argv[6] == "mixed":
+    flags = sys.argv[6:]
+    if "mixed" in flags:
         sep = sum(r["contact"] == "0" for r in a)
         stick = sum(r["contact"] == "1" and r["stick"] == "1" for r in a)
         slip = sum(r["contact"] == "1" and r["stick"] == "0" for r in a)
@@ -42,6 +45,11 @@ def main():
     print(f"Newton iterations {ja['newton_iterations']} vs {jb['newton_iterations']}, "
           f"ranks {ja.get('ranks')} vs {jb.get('ranks')}, converged {ja['converged']} / {jb['converged']}")
     ok = ok and ja["newton_iterations"] == jb["newton_iterations"] and ja["converged"] and jb["converged"]
+    krylov = ("outer_iterations", "inner_iterations")  # the Newton steps' CG, and the K_ii solves'
+    ka, kb = [tuple(j["counts"][k] for k in krylov) for j in (ja, jb)]
+    print(f"Krylov iterations (Newton-step CG, inner K_ii CG) {ka} vs {kb}")
+    if "krylov" in flags:
+        ok = ok and ka == kb
     print("same solution" if ok else "DIFFERENT")
     return 0 if ok else 1
 

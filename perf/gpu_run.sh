@@ -1,0 +1,204 @@
+#!/usr/bin/env bash
+# The device checks and benchmarks of the GPU bundle (perf/gpu_bundle.sh
+# copies this file to .gpu-bundle/run.sh, beside the programs), in stages
+# that each fit a 10-minute command:
+#   run.sh first    one call for a session with the 15-minute lease, the
+#                   most decisive first, each step under a timeout and all
+#                   of them within FIRST_BUDGET seconds (default 420): tests,
+#                   the level-13 apply, V-cycle and vector benchmarks,
+#                   contact (levels 8 and 12, Coulomb), level 14 on the GPU,
+#                   roofline, level 15; then a summary of the lines that
+#                   answer issue 22's bars
+#   run.sh tests    the device tests (a run without a usable GPU fails:
+#                   Device.PresentWhereRequired; GCC 12 falls back to the
+#                   host even with OMP_TARGET_OFFLOAD=MANDATORY)
+#   run.sh bench    the Device* benchmarks (BENCH=regex) and roofline
+#                   --device gpu at level 13 (DeviceAxpy/1024 and
+#                   DeviceDot/1024: what one launch costs)
+#   run.sh elastic  the MG-CG solve, GPU then CPU, levels 10, 12, 13
+#   run.sh contact  tresca, GPU then CPU, levels 8 and 12 and Coulomb 0.8 at
+#                   level 10, compared by compare_runs.py: contact values
+#                   within 1e-10 of each column's largest, same contact and
+#                   stick sets, same Newton and Krylov iterations (issue 22)
+#   run.sh large    tresca --device gpu at levels 13, 14 and 15
+#   run.sh warps    the team size (TRESCA_DEVICE_WARPS 1, 2, 4, 8, 16): the
+#                   level-13 apply, V-cycle and vector benchmarks and a
+#                   level-12 contact solve with each (perf/offload_registers.py
+#                   predicts the occupancy of each image; RESULTS.md §0n, §0z)
+#   run.sh cut      where the multigrid and the nested iteration leave the
+#                   device (TRESCA_DEVICE_MIN_NODES 0, 8192, 32768, 131072,
+#                   524288: smaller levels and coarser meshes on the host):
+#                   the level-10 and level-12 V-cycles and a level-12 contact
+#                   solve with each (RESULTS.md §0w, §0y)
+#   run.sh images   the vector kernels in a device image of their own (this
+#                   build: libtresca_launch.so) against in the program's
+#                   (one-image/bench_kernels), alternating: axpy, dot, the CG
+#                   update and the level-12 V-cycle (RESULTS.md §0z)
+#   run.sh why      why a kernel runs as fast as it does (issue 22, item 6):
+#                   the launch geometry libgomp picks for each kernel
+#                   (GOMP_DEBUG=1: teams, warps) and, where Nsight Compute is
+#                   installed, its report on the apply (double, float), axpy,
+#                   dot and the CG update: registers, occupancy, waves,
+#                   memory throughput (ncu --clock-control none)
+#   run.sh all      tests, bench, elastic, contact (about 10 minutes)
+# Where OUT is set, each stage's log goes to $OUT/run_STAGE.log and its CSV
+# and JSON files to $OUT/run_STAGE.files.tgz (two files a stage; the device
+# tool brings back 8).
+#
+# The sizes are knobs, so that the whole script can be tried where there is
+# no GPU (the offload build's test perf.gpu_run_smoke, with its target regions
+# on the host): BENCH_LEVEL (13), VEC_SIZE (134217728), CONTACT_LEVELS
+# ("8 12"), COULOMB_LEVEL (10), ELASTIC_LEVELS ("10 12 13"), LARGE_LEVELS
+# ("13 14 15"), BENCH_ARGS (extra bench_kernels options), and first's
+# FIRST_BUDGET (420 s), FIRST_LARGE (14), FIRST_LARGEST (15); TRESCA_BIN is
+# where the programs are (default: beside this script), COMPARE the
+# compare_runs.py to use (default: beside this script, else tests/).
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+bin=${TRESCA_BIN:-$here}
+export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+export OMP_TARGET_OFFLOAD=${OMP_TARGET_OFFLOAD:-MANDATORY} TRESCA_REQUIRE_DEVICE=${TRESCA_REQUIRE_DEVICE:-1}
+stage=${1:-all}
+stages="first tests bench elastic contact large warps cut images why all"
+if [[ " $stages " != *" $stage "* ]]; then
+  echo "run.sh: unknown stage '$stage' (${stages// /, })" >&2
+  exit 2
+fi
+L=${BENCH_LEVEL:-13} V=${VEC_SIZE:-134217728}
+read -r -a bench_args <<< "${BENCH_ARGS:-}"
+compare_py=${COMPARE:-$here/compare_runs.py}
+[[ -f $compare_py ]] || compare_py=$here/../tests/compare_runs.py
+base=${TMPDIR:-/tmp}/tresca-gpu-run
+out=$base/$stage  # the stage's CSV and JSON files (and first's logs)
+rm -rf "$out" && mkdir -p "$out"
+if [[ -n ${OUT:-} && -z ${RUN_SH_LOGGED:-} ]]; then
+  set +e
+  RUN_SH_LOGGED=1 bash "$0" "$stage" 2>&1 | tee "$OUT/run_$stage.log"
+  rc=${PIPESTATUS[0]}
+  tar czf "$OUT/run_$stage.files.tgz" -C "$base" .
+  exit "$rc"
+fi
+if [[ -z ${RUN_SH_NESTED:-} ]]; then
+  echo "# run.sh $stage, $(date -u '+%F %H:%M UTC'); $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) CPUs"
+  nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader 2>/dev/null || echo "no nvidia-smi"
+fi
+bench() {  # a benchmark filter
+  "$bin/bench_kernels" --benchmark_filter="$1" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+    "${bench_args[@]}"
+}
+solve() {  # tresca's options: the run, named first; a failed one says so and the stage goes on
+  echo "== tresca $*"
+  "$bin/tresca" "$@" || echo "(exit status $?)"
+}
+contact() {  # level, then tresca options: GPU, then CPU, then their comparison
+  local level=$1; shift
+  local opts="$*"
+  local name="$level${opts:+_${opts//[^a-z0-9.]/}}"  # (e.g. 10_coulomb0.8)
+  solve --level "$level" "$@" --device gpu --profile --contact-csv "$out/gpu_$name.csv" --json "$out/gpu_$name.json"
+  solve --level "$level" "$@" --quiet --contact-csv "$out/cpu_$name.csv" --json "$out/cpu_$name.json"
+  echo "== level $level $*: GPU against CPU"
+  python3 "$compare_py" "$out/gpu_$name.csv" "$out/gpu_$name.json" "$out/cpu_$name.csv" "$out/cpu_$name.json" \
+    1e-10 krylov || true
+}
+# the stages of `first`: a stage under a timeout, with its knobs, skipped
+# when less than MIN seconds of the budget are left
+deadline=$((SECONDS + ${FIRST_BUDGET:-420}))
+step() {  # MAX MIN LABEL STAGE [VAR=value...]: the stage's output also in $out/LABEL.log
+  local max=$1 min=$2 label=$3 name=$4; shift 4
+  local left=$((deadline - SECONDS))
+  if ((left < min)); then
+    echo "== first: $label skipped ($left s of the budget left, it needs $min)"
+    return 0
+  fi
+  ((max > left)) && max=$left
+  echo "== first: $label (at most $max s)"
+  local t0=$SECONDS rc=0
+  env "$@" RUN_SH_NESTED=1 timeout -k 10 "$max" bash "$0" "$name" 2>&1 | tee "$out/$label.log" || rc=$?
+  echo "== first: $label ended after $((SECONDS - t0)) s, exit status $rc$( ((rc == 124)) && echo ' (timed out)')"
+}
+if [[ $stage == first ]]; then
+  step 150 30 1-tests tests
+  step 120 30 2-bench bench BENCH="Device(Apply|ApplyFloat|VCycle|RestrictProlong)/$L/|Device(Dot|Axpy|CgUpdate)/$V/|Device(Axpy|Dot)/1024/" NO_ROOFLINE=1
+  step 150 60 3-contact contact
+  step 90 30 4-large large LARGE_LEVELS="${FIRST_LARGE:-14}"
+  step 60 20 5-roofline bench BENCH=none
+  step 150 60 6-largest large LARGE_LEVELS="${FIRST_LARGEST:-15}"
+  # the lines that answer issue 22's bars, step by step: tests passed, the
+  # benchmarks' medians, each solve's verdict, work and times, GPU against
+  # CPU, the roofline's device triad and kernels, and every failure
+  echo "== summary (whole logs above, and in run_first.log where OUT is set)"
+  keep='^\[ +(PASSED|FAILED) +\]|_median|^== |largest difference|sets equal|iterations .* vs|same solution|DIFFERENT'
+  keep+='|^(converged|not converged)|^work: .*peak|^times \[s\]|^# device|^(apply y|apply \(float|dot |axpy |cg_update|V-cycle \()'
+  keep+='|exit status [1-9]|error|refused'
+  for f in "$out"/*.log; do
+    echo "-- ${f##*/}"
+    grep -E "$keep" "$f" || true
+  done
+  exit 0
+fi
+if [[ $stage == tests || $stage == all ]]; then
+  "$bin/test_device"
+fi
+if [[ $stage == bench || $stage == all ]]; then
+  [[ ${BENCH:-} == none ]] || bench "${BENCH:-Device}"
+  [[ -n ${NO_ROOFLINE:-} ]] || "$bin/roofline" --level "$L" --device gpu
+fi
+if [[ $stage == elastic || $stage == all ]]; then
+  for level in ${ELASTIC_LEVELS:-10 12 13}; do
+    "$bin/elastic" --level "$level" --device gpu
+    "$bin/elastic" --level "$level"
+  done
+fi
+if [[ $stage == contact || $stage == all ]]; then
+  for level in ${CONTACT_LEVELS:-8 12}; do
+    contact "$level"
+  done
+  contact "${COULOMB_LEVEL:-10}" --coulomb 0.8
+fi
+if [[ $stage == warps ]]; then
+  for w in 1 2 4 8 16; do
+    echo "== TRESCA_DEVICE_WARPS=$w"
+    TRESCA_DEVICE_WARPS=$w bench "Device(Apply|ApplyFloat|VCycle)/$L/|Device(Dot|CgUpdate)/$V/"
+    TRESCA_DEVICE_WARPS=$w "$bin/tresca" --level 12 --device gpu --quiet --json "$out/warps_$w.json"
+  done
+fi
+if [[ $stage == cut ]]; then
+  for m in 0 8192 32768 131072 524288; do
+    echo "== TRESCA_DEVICE_MIN_NODES=$m"
+    TRESCA_DEVICE_MIN_NODES=$m bench 'DeviceVCycle/(10|12)/'
+    TRESCA_DEVICE_MIN_NODES=$m "$bin/tresca" --level 12 --device gpu --profile --json "$out/cut_$m.json" |
+      grep -E 'nested:|^times|host levels|^launches|on the device:'
+  done
+fi
+if [[ $stage == images ]]; then
+  for round in 1 2; do
+    for b in "$bin" "$here/one-image"; do
+      echo "== $b/bench_kernels (round $round)"
+      "$b/bench_kernels" --benchmark_filter="Device(Axpy|Dot|CgUpdate)/(1024|$V)/|DeviceVCycle/12/" \
+        --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+    done
+  done
+fi
+if [[ $stage == why ]]; then
+  filter='Device(Apply|ApplyFloat)/12/|Device(Axpy|Dot|CgUpdate)/16777216/'
+  echo "== launches as libgomp makes them (count, kernel, geometry)"
+  GOMP_DEBUG=1 "$bin/bench_kernels" --benchmark_filter="$filter" --benchmark_min_time=0.01 2>&1 |
+    sed -nE 's/.*kernel ([^:]*): launch (.*)/\1 \2/p' | sort | uniq -c | sort -rn | head -30
+  ncu=$(command -v ncu || ls /opt/nvidia/nsight-compute/*/ncu 2>/dev/null | head -1 || true)
+  if [[ -z $ncu ]]; then
+    echo "no ncu (Nsight Compute): no kernel reports"
+  else
+    for k in 'elasticity_apply_rowsIdE' 'elasticity_apply_rowsIfE' 'NS_4axpyE' 'NS_3dotIdEE' 'NS_9cg_updateE'; do
+      echo "== ncu: the first kernel whose mangled name matches $k"
+      "$ncu" --clock-control none --kernel-name-base mangled --kernel-name "regex:$k" --launch-skip 2 --launch-count 1 \
+        --section SpeedOfLight --section Occupancy --section LaunchStats --section MemoryWorkloadAnalysis \
+        "$bin/bench_kernels" --benchmark_filter="$filter" --benchmark_min_time=0.01 2>&1 |
+        grep -vE '^(Device|-----|Benchmark|Run on|CPU Caches|  L[123]|Load Average|\*\*\*)' | head -80
+    done
+  fi
+fi
+if [[ $stage == large ]]; then
+  for level in ${LARGE_LEVELS:-13 14 15}; do
+    solve --level "$level" --device gpu --profile --json "$out/gpu_$level.json"
+  done
+fi
