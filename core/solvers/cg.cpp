@@ -1,6 +1,7 @@
 #include "core/solvers/cg.hpp"
 
 #include <cmath>
+#include <utility>
 #include <stdexcept>
 #include <string>
 
@@ -48,7 +49,8 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     else
       A.apply(in, out);
   };
-  st.rhs_norm = std::sqrt(global(dot(n, b, b)));
+  const real bb = global(dot(n, b, b));
+  st.rhs_norm = std::sqrt(bb);
   if (opt.zero_initial_guess) {
     fill<real>(n, 0, x);
     copy(n, b, r);
@@ -59,10 +61,10 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
       axpy(side->side_size(), 1, sp, side_x);
     else if (side)
       copy(side->side_size(), sp, side_x);
-    copy(n, b, r);
-    axpy(n, -1, q, r);
+    triad(n, b, -1, q, r);  // r = b - A x in one sweep
   }
-  real rr = global(dot(n, r, r));
+  // (from x = 0, r is a copy of b: the same sum, bit for bit, without a sweep)
+  real rr = opt.zero_initial_guess ? bb : global(dot(n, r, r));
   st.initial_residual = st.residual = std::sqrt(rr);
   const real target = std::max(opt.rtol * st.rhs_norm, opt.atol);
   if (!std::isfinite(rr)) {
@@ -79,8 +81,8 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
       copy(n, r, z);
   };
   precondition();
-  copy(n, z, p);
-  real rz = global(dot(n, r, z));
+  std::swap(z, p);  // p = z without a copy: z is written afresh before it is read again
+  real rz = global(dot(n, r, p));
   for (int it = 1; it <= opt.max_iterations; ++it) {
     if (!(rz > 0)) {
       st.reason = std::isfinite(rz) ? SolveReason::breakdown : SolveReason::non_finite;
