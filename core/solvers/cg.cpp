@@ -1,9 +1,9 @@
 #include "core/solvers/cg.hpp"
 
 #include <cmath>
-#include <utility>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "kernels/vector_ops.hpp"
 #include "core/util/profile.hpp"
