@@ -70,7 +70,13 @@ compare_py=${COMPARE:-$here/compare_runs.py}
 [[ -f $compare_py ]] || compare_py=$here/../tests/compare_runs.py
 base=${TMPDIR:-/tmp}/tresca-gpu-run
 out=$base/$stage  # the stage's CSV and JSON files (and first's logs)
-rm -rf "$out" && mkdir -p "$out"
+# a stage run by hand starts afresh, `first` with all of its steps' folders
+# (a step keeps what an earlier step of the same stage wrote: 4-large's
+# level 14 beside 6-largest's level 15)
+if [[ -z ${RUN_SH_NESTED:-} ]]; then
+  if [[ $stage == first ]]; then rm -rf "$base"; else rm -rf "$out"; fi
+fi
+mkdir -p "$out"
 if [[ -n ${OUT:-} && -z ${RUN_SH_LOGGED:-} ]]; then
   set +e
   RUN_SH_LOGGED=1 bash "$0" "$stage" 2>&1 | tee "$OUT/run_$stage.log"
