@@ -233,8 +233,9 @@ namespace {
 // Whether this run's threads find the machine's cores free at start: the
 // tasks running besides this one (/proc/loadavg, fewest of five looks 1 ms
 // apart, so that a short-lived daemon does not count) plus the threads it
-// will start fit in the cores. A snapshot: a process that starts later is
-// not seen.
+// will start fit in the cores (threads beyond the cores are this run's own
+// oversubscription, which thread_placement's warning names, not another
+// process's). A snapshot: a process that starts later is not seen.
 bool cores_free_at_start() {
   long running = -1;
   for (int look = 0; look < 5; ++look) {
@@ -249,7 +250,7 @@ bool cores_free_at_start() {
   const long cores = sysconf(_SC_NPROCESSORS_ONLN);
   long threads = cores;
   if (const char* env = std::getenv("OMP_NUM_THREADS")) threads = std::strtol(env, nullptr, 10);
-  return cores > 0 && threads > 0 && (running - 1) + threads <= cores;
+  return cores > 0 && threads > 0 && (running - 1) + std::min(threads, cores) <= cores;
 }
 }  // namespace
 
