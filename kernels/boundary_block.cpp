@@ -9,9 +9,10 @@ void bottom_block_apply(const GridDims& g, const T* B, const T* x, const ApplyOu
   const index M = g.nx() * g.ny(), N = g.nodes();
   const T *bxx = B, *bxy = B + M, *byy = B + 2 * M, *bzz = B + 3 * M;
   const Cost step = writes_d(kind(out)) ? kChebStepExtraCost : Cost{};  // the Chebyshev step's dinv and d
+  const char* name = precision_name<T>("bottom block", "bottom block (float)");
   with_kind(out, [&](auto kind) {
     constexpr OutKind K = decltype(kind)::value;
-    for_each_entry(M, in_precision<T>(kBottomBlockCost + step), [=](index n) {
+    for_each_entry(name, M, in_precision<T>(kBottomBlockCost + step), [=](index n) {
       const T ux = x[n], uy = x[N + n], uz = x[2 * N + n];
       add<K>(out, n, bxx[n] * ux + bxy[n] * uy);
       add<K>(out, N + n, bxy[n] * ux + byy[n] * uy);
@@ -24,7 +25,7 @@ template void bottom_block_apply<float>(const GridDims&, const float*, const flo
 
 void bottom_block_diagonal(const GridDims& g, const real* B, real* d) {
   const index M = g.nx() * g.ny(), N = g.nodes();
-  for_each_entry(M, Cost{72, 3}, [=](index n) {
+  for_each_entry("bottom block diagonal", M, Cost{72, 3}, [=](index n) {
     d[n] += B[n];
     d[N + n] += B[2 * M + n];
     d[2 * N + n] += B[3 * M + n];

@@ -33,7 +33,8 @@ inline NodeStep node_step(real s, real phi, real x1, real x2, real x3, real x4, 
 StateCounts count_states(index p, const std::uint8_t* status) {
   // three counts where the status lives (each a deterministic sum)
   auto count = [=](ContactState which) {
-    return index(sum_over_entries(p, Cost{1, 1}, [=](index i) { return real(contact_state(status[i]) == which); }));
+    return index(sum_over_entries("count states", p, Cost{1, 1},
+                                  [=](index i) { return real(contact_state(status[i]) == which); }));
   };
   StateCounts c;
   c.separated = count(ContactState::separated);
@@ -43,7 +44,7 @@ StateCounts count_states(index p, const std::uint8_t* status) {
 }
 
 void coulomb_bound(index p, real F, const real* lambda, real* phi) {
-  for_each_entry(p, Cost{16, 2}, [=](index i) { phi[i] = F * (lambda[i] > 0 ? lambda[i] : real(0)); });
+  for_each_entry("coulomb bound", p, Cost{16, 2}, [=](index i) { phi[i] = F * (lambda[i] > 0 ? lambda[i] : real(0)); });
 }
 
 ResidualNorms approximation_step(index p, const ContactLaw& law, const real* scale, const real* units, const real* u,
@@ -64,7 +65,7 @@ ResidualNorms approximation_step(index p, const ContactLaw& law, const real* sca
   // in tests/test_newton.cpp, ApproximationStep; the dense reference Newton
   // there.)
   auto sweep = [&](auto has_units, auto has_scale) {
-    for_each_entry(p, kApproximationStepCost, [=](index i) {
+    for_each_entry("approximation step", p, kApproximationStepCost, [=](index i) {
       // x3 enters through F_4 = u_z + g
       const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + law.gap[i], x4 = lambda[i];
       const real r1 = r[i], r2 = r[p + i];

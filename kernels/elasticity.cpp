@@ -166,7 +166,8 @@ void elasticity_apply(const ElasticityStencilT<T>& k, const T* x, const ApplyOut
   const StencilView<T> v = view(k);
   // each band's arithmetic in the instruction set chosen at start (isa.hpp)
   const auto apply_band = isa_apply_band<T>(isa());
-  for_each_host_share(rows_y * rows_z, nodes * in_precision<T>(apply_cost(out)), [=](Share s) {
+  const char* name = precision_name<T>("apply", "apply (float)");
+  for_each_host_share(name, rows_y * rows_z, nodes * in_precision<T>(apply_cost(out)), [=](Share s) {
     for_each_row_band(rows, s, kBand, [&](const RowBlock& b) { apply_band(v, x, out, b); });
   });
 }
@@ -193,9 +194,10 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
   const index z0 = rows.z_begin, y0 = rows.y_begin;
   const index nz = rows.z_end - rows.z_begin, nyr = rows.y_end - rows.y_begin;
   const double nodes = double(nx) * double(nz) * double(nyr);
+  const char* name = precision_name<T>("apply", "apply (float)");  // (the banded apply's device form)
   with_kind(out, [&](auto kind) {
     constexpr OutKind K = decltype(kind)::value;
-    for_each_block(nz, nyr, nodes * in_precision<T>(apply_cost(out)), [=](index jz, index jy) {
+    for_each_block(name, nz, nyr, nodes * in_precision<T>(apply_cost(out)), [=](index jz, index jy) {
       sweep_row<K>(k, nx, ny, N, z0 + jz, y0 + jy, x, out,
                    [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
                      const StencilGroupT<T>*q0 = k.groups + f[0], *q1 = k.groups + f[7];
@@ -275,7 +277,7 @@ void elasticity_diagonal(const ElasticityStencil& k, real* d) {
   const real* center = k.center.data();
   const GridDims g = k.g;
   const index nx = g.nx(), N = g.nodes();
-  for_each_block(g.nz(), g.ny(), double(N) * kDiagonalCost, [=](index iz, index iy) {
+  for_each_block("diagonal", g.nz(), g.ny(), double(N) * kDiagonalCost, [=](index iz, index iy) {
     const std::uint8_t cy = v.cls[1][iy], cz = v.cls[2][iz];
     TRESCA_DEVICE_LANES  // (reads slot and center through indices)
     for (index ix = 0; ix < nx; ++ix) {
@@ -312,7 +314,7 @@ void zero_constrained(const GridDims& g, unsigned faces, T* v) {
   // constrained x faces (O(surface) work, one launch)
   const index nx = g.nx(), ny = g.ny(), nz = g.nz(), N = g.nodes();
   if (!faces) return;
-  for_each_block(nz, ny, double(ny) * double(nz) * Cost{48, 0}, [=](index iz, index iy) {
+  for_each_block("zero constrained", nz, ny, double(ny) * double(nz) * Cost{48, 0}, [=](index iz, index iy) {
     const ConstrainedRow c(g, faces, iy, iz);
     for (int a = 0; a < 3; ++a) {
       T* row = v + a * N + nx * (iy + ny * iz);

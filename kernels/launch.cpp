@@ -58,6 +58,50 @@ void detail::count_threaded_launch(double work, long long ns) {
   work_by_size[k].store(w + work, std::memory_order_relaxed);
 }
 
+namespace {
+// the census by kernel: a slot per kernel name, its counts by where they ran
+struct KernelSlot {
+  const char* kernel;
+  long long calls[int(Ran::count)] = {};
+  long long ns[int(Ran::count)] = {};
+  double bytes[int(Ran::count)] = {}, flops[int(Ran::count)] = {};
+};
+std::mutex kernel_slots_mutex;
+std::vector<KernelSlot>& kernel_slots() {
+  static std::vector<KernelSlot> slots;
+  return slots;
+}
+}  // namespace
+
+const char* to_string(Ran r) {
+  static const char* names[] = {"threads", "1 thread", "device", "copy"};
+  return names[int(r)];
+}
+
+void detail::count_kernel(const char* kernel, Ran ran, Cost work, long long ns) {
+  const std::lock_guard<std::mutex> lock(kernel_slots_mutex);
+  std::vector<KernelSlot>& slots = kernel_slots();
+  // a name is a string literal: the same pointer, or the same text where
+  // two translation units each hold a copy of it
+  auto s = std::find_if(slots.begin(), slots.end(),
+                        [&](const KernelSlot& k) { return k.kernel == kernel || !std::strcmp(k.kernel, kernel); });
+  if (s == slots.end()) s = slots.insert(slots.end(), KernelSlot{kernel});
+  const int r = int(ran);
+  s->calls[r] += 1;
+  s->ns[r] += ns;
+  s->bytes[r] += work.bytes;
+  s->flops[r] += work.flops;
+}
+
+std::vector<KernelLaunches> launches_by_kernel() {
+  const std::lock_guard<std::mutex> lock(kernel_slots_mutex);
+  std::vector<KernelLaunches> out;
+  for (const KernelSlot& s : kernel_slots())
+    for (int r = 0; r < int(Ran::count); ++r)
+      if (s.calls[r] > 0) out.push_back({s.kernel, Ran(r), s.calls[r], 1e-9 * double(s.ns[r]), s.bytes[r], s.flops[r]});
+  return out;
+}
+
 LaunchCounts launch_counts() {
   LaunchCounts c;
   c.threaded = detail::launches[0].load();
@@ -343,8 +387,8 @@ namespace {
 // on every thread instead of one, and each page on the thread (and the
 // NUMA node) that will use it. Small ranges stay on the calling thread.
 template <class Piece>
-void by_host_shares(std::size_t bytes, const Piece& piece) {
-  const detail::HostLaunch launch(Cost{double(bytes), 0});
+void by_host_shares(const char* kernel, std::size_t bytes, const Piece& piece) {
+  const detail::HostLaunch launch(kernel, Cost{double(bytes), 0});
   detail::on_host_workers(launch.threads, [&](index t, index w) {
     detail::for_entry_runs(index(bytes), t, w,
                            [&](index b0, index b1) { piece(std::size_t(b0), std::size_t(b1 - b0)); });
@@ -355,22 +399,29 @@ void by_host_shares(std::size_t bytes, const Piece& piece) {
 void space_copy(Space to_space, void* to, Space from_space, const void* from, std::size_t bytes) {
   if (bytes == 0) return;
   if (to_space == Space::host && from_space == Space::host) {
-    by_host_shares(bytes, [&](std::size_t b, std::size_t n) {
+    by_host_shares("copy (host memory)", bytes, [&](std::size_t b, std::size_t n) {
       std::memcpy(static_cast<char*>(to) + b, static_cast<const char*>(from) + b, n);
     });
     return;
   }
-  DeviceRegion region(true);
-  if (omp_target_memcpy(to, from, bytes, 0, 0, device_of(to_space), device_of(from_space)) != 0)
-    throw std::runtime_error(std::string("copying a field from the ") + to_string(from_space) + " to the " +
-                             to_string(to_space) + " failed");
+  const long long t0 = detail::now_ns();
+  {
+    DeviceRegion region(true);
+    if (omp_target_memcpy(to, from, bytes, 0, 0, device_of(to_space), device_of(from_space)) != 0)
+      throw std::runtime_error(std::string("copying a field from the ") + to_string(from_space) + " to the " +
+                               to_string(to_space) + " failed");
+  }
+  const char* kernel = from_space == Space::host ? "copy host to device"
+                       : to_space == Space::host ? "copy device to host"
+                                                 : "copy device to device";
+  detail::count_kernel(kernel, Ran::copy, Cost{double(bytes), 0}, detail::now_ns() - t0);
 }
 
 void space_zero(Space s, void* p, std::size_t bytes) {
   if (bytes == 0) return;
 #ifdef TRESCA_OFFLOAD
   if (s == Space::device) {
-    const detail::DeviceLaunch launch;
+    const detail::DeviceLaunch launch("zero (device memory)", Cost{double(bytes), 0});
     DeviceRegion region;
     unsigned char* q = static_cast<unsigned char*>(p);
 #pragma omp target teams distribute parallel for is_device_ptr(q) device(device())
@@ -383,7 +434,8 @@ void space_zero(Space s, void* p, std::size_t bytes) {
     std::memset(p, 0, bytes);
     return;
   }
-  by_host_shares(bytes, [&](std::size_t b, std::size_t n) { std::memset(static_cast<char*>(p) + b, 0, n); });
+  by_host_shares("zero (host memory)", bytes,
+                 [&](std::size_t b, std::size_t n) { std::memset(static_cast<char*>(p) + b, 0, n); });
 }
 
 bool device_guarded() { return guard().on; }

@@ -1,7 +1,7 @@
 // Where a kernel runs and where its vectors live: the one place that decides.
 //
-// Every kernel in kernels/ states its work as an index range, its modelled
-// Cost and a body (a lambda over plain pointers), and hands them to one of
+// Every kernel in kernels/ states its work as its name, an index range, its
+// modelled Cost and a body (a lambda over plain pointers), and hands them to one of
 // the launchers below; no kernel starts threads itself. This is the seam of
 // the backends (in the spirit of a `parallel_for` over an index range):
 //
@@ -150,6 +150,33 @@ struct LaunchCounts {
   double by_size_seconds[kSizes] = {}, by_size_work[kSizes] = {};
 };
 LaunchCounts launch_counts();
+
+// The same launches by kernel: every launcher names its kernel ("axpy",
+// "apply (float)"; the name of a template kernel's float variant ends in
+// " (float)", precision_name below), and each kernel's launches are kept
+// by where they ran, with their wall time and modelled traffic: the
+// `--profile` table "launches by kernel", in which every launch of a run
+// appears (the rows above it time the solvers' phases, this one the
+// kernels, on the host and on the device alike). Copies between host and
+// device memory (space_copy) are counted here too, as the kernel "copy
+// host to device" (or back), ran `copy`.
+enum class Ran : int { threaded, one_thread, device, copy, count };
+const char* to_string(Ran r);  // "threads", "1 thread", "device", "copy"
+struct KernelLaunches {
+  std::string kernel;
+  Ran ran = Ran::threaded;
+  long long calls = 0;
+  double seconds = 0, bytes = 0, flops = 0;  // (bytes and flops: the calls' modelled Cost, summed)
+};
+// every (kernel, where) with a launch since the program started, in the
+// order of their first launch
+std::vector<KernelLaunches> launches_by_kernel();
+// a template kernel's name in the census: its float variant's says so
+template <class T>
+constexpr const char* precision_name(const char* as_double, const char* as_float) {
+  return sizeof(T) == sizeof(float) ? as_float : as_double;
+}
+
 namespace detail {
 extern std::atomic<long long> launches[3];  // threaded, one_thread, device
 extern std::atomic<long long> launch_ns[3];  // threaded, one_thread, device
@@ -158,41 +185,50 @@ inline long long now_ns() {
       .count();
 }
 void count_threaded_launch(double work, long long ns);  // in its size class
-// One host launch: whether it starts threads (worth_threads(work)), counted
-// as what it is and timed until it goes out of scope. Host launches are
-// made from the driver's thread only (none nests in another).
+void count_kernel(const char* kernel, Ran ran, Cost work, long long ns);  // in launches_by_kernel
+// One host launch of a kernel: whether it starts threads
+// (worth_threads(work)), counted as what it is and timed until it goes out
+// of scope. Host launches are made from the driver's thread only (none
+// nests in another).
 class HostLaunch {
  public:
-  explicit HostLaunch(Cost work) : threads(worth_threads(work)), work_(work.bytes + work.flops), t0_(now_ns()) {}
+  HostLaunch(const char* kernel, Cost work)
+      : threads(worth_threads(work)), kernel_(kernel), work_(work), t0_(now_ns()) {}
   ~HostLaunch() {
     const long long ns = now_ns() - t0_;
     if (threads)
-      count_threaded_launch(work_, ns);
+      count_threaded_launch(work_.bytes + work_.flops, ns);
     else {
       launches[1].fetch_add(1, std::memory_order_relaxed);
       launch_ns[1].fetch_add(ns, std::memory_order_relaxed);
     }
+    count_kernel(kernel_, threads ? Ran::threaded : Ran::one_thread, work_, ns);
   }
   HostLaunch(const HostLaunch&) = delete;
   HostLaunch& operator=(const HostLaunch&) = delete;
   const bool threads;
 
  private:
-  double work_;
+  const char* kernel_;
+  Cost work_;
   long long t0_;
 };
 // One device launch (a target region), counted and timed likewise.
 class DeviceLaunch {
  public:
-  DeviceLaunch() : t0_(now_ns()) {}
+  DeviceLaunch(const char* kernel, Cost work) : kernel_(kernel), work_(work), t0_(now_ns()) {}
   ~DeviceLaunch() {
+    const long long ns = now_ns() - t0_;
     launches[2].fetch_add(1, std::memory_order_relaxed);
-    launch_ns[2].fetch_add(now_ns() - t0_, std::memory_order_relaxed);
+    launch_ns[2].fetch_add(ns, std::memory_order_relaxed);
+    count_kernel(kernel_, Ran::device, work_, ns);
   }
   DeviceLaunch(const DeviceLaunch&) = delete;
   DeviceLaunch& operator=(const DeviceLaunch&) = delete;
 
  private:
+  const char* kernel_;
+  Cost work_;
   long long t0_;
 };
 }  // namespace detail
@@ -225,7 +261,11 @@ namespace detail {
 // body(t, w) on each of the w workers of a host launch (one unless threads)
 template <class Body>
 inline void on_host_workers(bool threads, const Body& body) {
-#pragma omp parallel if (threads)
+  if (!threads) {  // (a parallel region of one thread still costs the runtime's team set-up: 0.2 us)
+    body(index(0), index(1));
+    return;
+  }
+#pragma omp parallel
   body(index(omp_get_thread_num()), index(omp_get_num_threads()));
 }
 // body(i0, i1) for each nonempty run of worker t's entries of [0, n)
@@ -246,10 +286,10 @@ inline void for_row_share(index n1, index n0, index t, index w, const Body& body
 
 // body(i) for every i in [0, n), independent entries vectorised across i.
 template <class Body>
-inline void for_each_entry(index n, Cost per_entry, const Body& body) {
+inline void for_each_entry(const char* kernel, index n, Cost per_entry, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
-    const detail::DeviceLaunch launch;
+    const detail::DeviceLaunch launch(kernel, double(n) * per_entry);
     // a copy of the body, mapped implicitly: its captures (device pointers,
     // scalars) travel by value (GCC 12 fails on a lambda in a map or
     // firstprivate clause: an internal compiler error)
@@ -261,7 +301,7 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
     return;
   }
 #endif
-  const detail::HostLaunch launch(double(n) * per_entry);
+  const detail::HostLaunch launch(kernel, double(n) * per_entry);
   detail::on_host_workers(launch.threads, [&](index t, index w) {
     const Body b = body;  // (each worker's own copy: its captures in registers, not reloaded after every store)
     detail::for_entry_runs(n, t, w, [&](index i0, index i1) {
@@ -288,8 +328,8 @@ inline void for_each_entry(index n, Cost per_entry, const Body& body) {
 // image: there the most register-hungry body sets the registers, and so the
 // occupancy, of every kernel (perf/offload_registers.py, RESULTS.md §0n).
 template <class Body>
-inline void for_each_host_block(index n, Cost work, const Body& body) {
-  const detail::HostLaunch launch(work);
+inline void for_each_host_block(const char* kernel, index n, Cost work, const Body& body) {
+  const detail::HostLaunch launch(kernel, work);
   detail::on_host_workers(launch.threads, [&](index t, index w) {
     detail::for_entry_runs(n, t, w, [&](index b0, index b1) {
       for (index b = b0; b < b1; ++b) body(b);
@@ -301,8 +341,8 @@ inline void for_each_host_block(index n, Cost work, const Body& body) {
 // for a kernel that sweeps its rows in an order of its own (the banded
 // apply's cache bands, kernels/elasticity.cpp). Host only, like the above.
 template <class Body>
-inline void for_each_host_share(index n, Cost work, const Body& body) {
-  const detail::HostLaunch launch(work);
+inline void for_each_host_share(const char* kernel, index n, Cost work, const Body& body) {
+  const detail::HostLaunch launch(kernel, work);
   detail::on_host_workers(launch.threads, [&](index t, index w) { body(host_share(n, t, w)); });
 }
 
@@ -310,10 +350,10 @@ inline void for_each_host_share(index n, Cost work, const Body& body) {
 // bands of rows), each vectorised inside by its own body. `work` is the
 // whole launch's modelled cost.
 template <class Body>
-inline void for_each_block(index n, Cost work, const Body& body) {
+inline void for_each_block(const char* kernel, index n, Cost work, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
-    const detail::DeviceLaunch launch;
+    const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
     Body b = body;
     const int warps = device_warps();
@@ -322,15 +362,15 @@ inline void for_each_block(index n, Cost work, const Body& body) {
     return;
   }
 #endif
-  for_each_host_block(n, work, body);
+  for_each_host_block(kernel, n, work, body);
 }
 
 // body(j, i) for every block of an n1 x n0 range (j slow, i fast).
 template <class Body>
-inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
+inline void for_each_block(const char* kernel, index n1, index n0, Cost work, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {  // one block per (team) thread; the body's own `omp simd` loops in its lanes
-    const detail::DeviceLaunch launch;
+    const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
     Body b = body;
     const int warps = device_warps();
@@ -340,7 +380,7 @@ inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
     return;
   }
 #endif
-  const detail::HostLaunch launch(work);
+  const detail::HostLaunch launch(kernel, work);
   detail::on_host_workers(launch.threads,
                           [&](index t, index w) { detail::for_row_share(n1, n0, t, w, body); });
 }
@@ -348,10 +388,11 @@ inline void for_each_block(index n1, index n0, Cost work, const Body& body) {
 // The same, with `scratch` entries of T private to each worker for the
 // launch (allocated once per launch, not per block): body(j, i, scratch).
 template <class T, class Body>
-inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost work, const Body& body) {
+inline void for_each_block_with_scratch(const char* kernel, index n1, index n0, index scratch, Cost work,
+                                        const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {  // each (team, thread) its slice of one scratch buffer
-    const detail::DeviceLaunch launch;
+    const detail::DeviceLaunch launch(kernel, work);
     const int warps = device_warps();
     T* pool = static_cast<T*>(device_scratch(std::size_t(kScratchTeams) * warps * scratch * sizeof(T)));
     DeviceRegion region;
@@ -363,7 +404,7 @@ inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost 
     return;
   }
 #endif
-  const detail::HostLaunch launch(work);
+  const detail::HostLaunch launch(kernel, work);
   detail::on_host_workers(launch.threads, [&](index t, index w) {
     std::vector<T> buffer(scratch);
     T* s = buffer.data();
@@ -379,7 +420,8 @@ inline void for_each_block_with_scratch(index n1, index n0, index scratch, Cost 
 // form: a team per block, its entries across the team's threads and lanes
 // (one GPU thread walking a block of 4096 would read memory uncoalesced).
 template <class Block, class Entry>
-inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& block, const Entry& entry) {
+inline real sum_over_blocks(const char* kernel, index n, index width, Cost per_entry, const Block& block,
+                            const Entry& entry) {
   const index nb = (n + width - 1) / width;
   constexpr index kStack = 256;
   real stack[kStack];
@@ -392,7 +434,7 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
   (void)entry;  // (the host's form is block)
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
-    const detail::DeviceLaunch launch;
+    const detail::DeviceLaunch launch(kernel, double(n) * per_entry);
     DeviceRegion region;
     Entry e = entry;
     const int warps = device_warps();
@@ -408,7 +450,7 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
 #endif
   {
     // each block on the worker that owns its first entry
-    const detail::HostLaunch launch(double(n) * per_entry);
+    const detail::HostLaunch launch(kernel, double(n) * per_entry);
     detail::on_host_workers(launch.threads, [&](index t, index w) {
       detail::for_entry_runs(n, t, w, [&](index i0, index i1) {
         for (index b = (i0 + width - 1) / width; b * width < i1; ++b)
@@ -425,10 +467,10 @@ inline real sum_over_blocks(index n, index width, Cost per_entry, const Block& b
 // forms from the one term): for sums whose term is not worth an explicit
 // vector block (counts, reductions over contact nodes).
 template <class Entry>
-inline real sum_over_entries(index n, Cost per_entry, const Entry& entry) {
+inline real sum_over_entries(const char* kernel, index n, Cost per_entry, const Entry& entry) {
   constexpr index kWidth = 4096;
   return sum_over_blocks(
-      n, kWidth, per_entry,
+      kernel, n, kWidth, per_entry,
       [&](index i0, index i1) {
         real s = 0;
         for (index i = i0; i < i1; ++i) s += entry(i);

@@ -126,8 +126,8 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, const T*
       }
     }
   };
-  for_each_block_with_scratch<T>(f.nz(), f.ny(), cnx, double(comps) * double(Nf) * in_precision<T>(kProlongateCost),
-                                 fine_row);
+  for_each_block_with_scratch<T>(precision_name<T>("prolongation", "prolongation (float)"), f.nz(), f.ny(), cnx,
+                                 double(comps) * double(Nf) * in_precision<T>(kProlongateCost), fine_row);
 }
 
 template void prolongate<double>(const Transfer&, int, const double*, double*, const double*, unsigned);
@@ -184,8 +184,8 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse, 
       }
     }
   };
-  for_each_block_with_scratch<T>(c.nz(), c.ny(), fnx, double(comps) * double(Nf) * in_precision<T>(kRestrictCost),
-                                 coarse_row);
+  for_each_block_with_scratch<T>(precision_name<T>("restriction", "restriction (float)"), c.nz(), c.ny(), fnx,
+                                 double(comps) * double(Nf) * in_precision<T>(kRestrictCost), coarse_row);
 }
 
 template void restrict_to_coarse<double>(const Transfer&, int, const double*, double*, unsigned);

@@ -53,7 +53,7 @@ real block_dot(index i0, index i1, const T* x, const T* w, const T* y) {
 
 template <class T>
 real dot(index n, const T* x, const T* y) {
-  return sum_over_blocks(n, kDotBlock, in_precision<T>(kDotCost),
+  return sum_over_blocks(precision_name<T>("dot", "dot (float)"), n, kDotBlock, in_precision<T>(kDotCost),
                          [x, y](index i0, index i1) { return block_dot<false>(i0, i1, x, x, y); },
                          [x, y](index i) { return real(x[i]) * real(y[i]); });
 }
@@ -68,34 +68,34 @@ real dot_ref(index n, const T* x, const T* y) {
 real norm2(index n, const real* x) { return std::sqrt(dot(n, x, x)); }
 
 void axpy(index n, real a, const real* x, real* y) {
-  for_each_entry(n, kAxpyCost, [=](index i) { y[i] += a * x[i]; });
+  for_each_entry("axpy", n, kAxpyCost, [=](index i) { y[i] += a * x[i]; });
 }
 void xpay(index n, const real* x, real a, real* y) {
-  for_each_entry(n, kXpayCost, [=](index i) { y[i] = x[i] + a * y[i]; });
+  for_each_entry("xpay", n, kXpayCost, [=](index i) { y[i] = x[i] + a * y[i]; });
 }
 void copy(index n, const real* x, real* y) {
-  for_each_entry(n, kCopyCost, [=](index i) { y[i] = x[i]; });
+  for_each_entry("copy", n, kCopyCost, [=](index i) { y[i] = x[i]; });
 }
 template <class T>
 void fill(index n, T v, T* y) {
-  for_each_entry(n, in_precision<T>(kFillCost), [=](index i) { y[i] = v; });
+  for_each_entry(precision_name<T>("fill", "fill (float)"), n, in_precision<T>(kFillCost), [=](index i) { y[i] = v; });
 }
 void scale(index n, real a, real* y) {
-  for_each_entry(n, kScaleCost, [=](index i) { y[i] *= a; });
+  for_each_entry("scale", n, kScaleCost, [=](index i) { y[i] *= a; });
 }
 void hadamard(index n, const real* d, const real* x, real* y) {
-  for_each_entry(n, kHadamardCost, [=](index i) { y[i] = d[i] * x[i]; });
+  for_each_entry("hadamard", n, kHadamardCost, [=](index i) { y[i] = d[i] * x[i]; });
 }
 void triad(index n, const real* b, real s, const real* c, real* a) {
-  for_each_entry(n, kTriadCost, [=](index i) { a[i] = b[i] + s * c[i]; });
+  for_each_entry("triad", n, kTriadCost, [=](index i) { a[i] = b[i] + s * c[i]; });
 }
 
 namespace {
 // body(k) at entry k of each of the three runs, one launch
 template <class Body>
-void for_each_component_entry(const ComponentRuns& r, Cost per_entry, const Body& body) {
+void for_each_component_entry(const char* kernel, const ComponentRuns& r, Cost per_entry, const Body& body) {
   const index N = r.N, first = r.first;
-  for_each_entry(r.count, 3 * per_entry, [=](index i) {
+  for_each_entry(kernel, r.count, 3 * per_entry, [=](index i) {
     body(first + i);
     body(N + first + i);
     body(2 * N + first + i);
@@ -104,21 +104,21 @@ void for_each_component_entry(const ComponentRuns& r, Cost per_entry, const Body
 }  // namespace
 
 void axpy(const ComponentRuns& r, real a, const real* x, real* y) {
-  for_each_component_entry(r, kAxpyCost, [=](index k) { y[k] += a * x[k]; });
+  for_each_component_entry("axpy (component runs)", r, kAxpyCost, [=](index k) { y[k] += a * x[k]; });
 }
 void copy(const ComponentRuns& r, const real* x, real* y) {
-  for_each_component_entry(r, kCopyCost, [=](index k) { y[k] = x[k]; });
+  for_each_component_entry("copy (component runs)", r, kCopyCost, [=](index k) { y[k] = x[k]; });
 }
 void fill(const ComponentRuns& r, real v, real* y) {
-  for_each_component_entry(r, kFillCost, [=](index k) { y[k] = v; });
+  for_each_component_entry("fill (component runs)", r, kFillCost, [=](index k) { y[k] = v; });
 }
 void scale(const ComponentRuns& r, real a, real* y) {
-  for_each_component_entry(r, kScaleCost, [=](index k) { y[k] *= a; });
+  for_each_component_entry("scale (component runs)", r, kScaleCost, [=](index k) { y[k] *= a; });
 }
 
 real cg_update(index n, real a, const real* p, const real* q, real* x, real* r) {
   // fused in blocks so that r is still in cache (registers) when r.r is formed
-  return sum_over_blocks(n, kDotBlock, kCgUpdateCost, [=](index i0, index i1) {
+  return sum_over_blocks("cg update", n, kDotBlock, kCgUpdateCost, [=](index i0, index i1) {
     V s0{};
     index i = i0;
     for (; i + kL <= i1; i += kL) {
@@ -152,7 +152,8 @@ real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real*
 template <class T>
 real jacobi_cg_update(index n, T a, const T* q, const T* dinv, T* r) {
   // the update, then its block's sum while r is in cache
-  return sum_over_blocks(n, kDotBlock, in_precision<T>(kJacobiCgUpdateCost), [=](index i0, index i1) {
+  const char* name = precision_name<T>("jacobi cg update", "jacobi cg update (float)");
+  return sum_over_blocks(name, n, kDotBlock, in_precision<T>(kJacobiCgUpdateCost), [=](index i0, index i1) {
 #pragma omp simd
     for (index i = i0; i < i1; ++i) r[i] -= a * q[i];
     return block_dot<true>(i0, i1, r, dinv, r);
@@ -174,32 +175,38 @@ real jacobi_cg_update_ref(index n, T a, const T* q, const T* dinv, T* r) {
 
 template <class T>
 void jacobi_xpay(index n, const T* dinv, const T* r, T b, T* p) {
-  for_each_entry(n, in_precision<T>(kJacobiXpayCost), [=](index i) { p[i] = dinv[i] * r[i] + b * p[i]; });
+  for_each_entry(precision_name<T>("jacobi xpay", "jacobi xpay (float)"), n, in_precision<T>(kJacobiXpayCost),
+                 [=](index i) { p[i] = dinv[i] * r[i] + b * p[i]; });
 }
 
 template <class To, class From>
 void convert(index n, const From* x, To* y) {
-  for_each_entry(n, Cost{double(sizeof(From) + sizeof(To)), 0}, [=](index i) { y[i] = To(x[i]); });
+  for_each_entry(precision_name<To>("convert to double", "convert to float"), n,
+                 Cost{double(sizeof(From) + sizeof(To)), 0}, [=](index i) { y[i] = To(x[i]); });
 }
 
 template <class To, class From>
 void scatter_to(index n, const index* at, const From* x, To* y) {
-  for_each_entry(n, Cost{double(sizeof(index) + sizeof(From) + 2 * sizeof(To)), 0}, [=](index k) { y[at[k]] = To(x[k]); });
+  for_each_entry("scatter", n, Cost{double(sizeof(index) + sizeof(From) + 2 * sizeof(To)), 0},
+                 [=](index k) { y[at[k]] = To(x[k]); });
 }
 
 template <class To, class From>
 void gather_from(index n, const index* at, const From* x, To* y) {
-  for_each_entry(n, Cost{double(sizeof(index) + sizeof(From) + 2 * sizeof(To)), 0}, [=](index k) { y[k] = To(x[at[k]]); });
+  for_each_entry("gather", n, Cost{double(sizeof(index) + sizeof(From) + 2 * sizeof(To)), 0},
+                 [=](index k) { y[k] = To(x[at[k]]); });
 }
 
 template <class To>
 void reciprocal_or_zero(index n, const real* x, To* y) {
-  for_each_entry(n, Cost{double(sizeof(real) + sizeof(To)), 1}, [=](index i) { y[i] = x[i] != 0 ? To(1 / x[i]) : To(0); });
+  for_each_entry(precision_name<To>("reciprocal", "reciprocal (float)"), n, Cost{double(sizeof(real) + sizeof(To)), 1},
+                 [=](index i) { y[i] = x[i] != 0 ? To(1 / x[i]) : To(0); });
 }
 
 template <class T>
 void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x) {
-  for_each_entry(n, in_precision<T>(kChebUpdateCost), [=](index i) {
+  const char* name = precision_name<T>("chebyshev update", "chebyshev update (float)");
+  for_each_entry(name, n, in_precision<T>(kChebUpdateCost), [=](index i) {
       d[i] = s * d[i] + t * dinv[i] * r[i];
       x[i] += d[i];
   });
@@ -207,10 +214,11 @@ void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x) {
 
 template <class T>
 void cheb_first(index n, T t, const T* dinv, const T* r, T* d, T* x, bool from_zero) {
+  const char* name = precision_name<T>("chebyshev first", "chebyshev first (float)");
   if (from_zero)
-    for_each_entry(n, in_precision<T>(kChebFirstCost), [=](index i) { x[i] = d[i] = t * dinv[i] * r[i]; });
+    for_each_entry(name, n, in_precision<T>(kChebFirstCost), [=](index i) { x[i] = d[i] = t * dinv[i] * r[i]; });
   else
-    for_each_entry(n, in_precision<T>(kChebFirstOnGuessCost), [=](index i) {
+    for_each_entry(name, n, in_precision<T>(kChebFirstOnGuessCost), [=](index i) {
       d[i] = t * dinv[i] * r[i];
       x[i] += d[i];
     });

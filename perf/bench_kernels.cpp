@@ -149,7 +149,7 @@ BENCHMARK_TEMPLATE(BM_VCycle, Run::device)->Name("DeviceVCycle")->DenseRange(8, 
 // a join and its barrier at this thread count (times the `regions` of a
 // V-cycle or the census of `tresca --profile`: what the threads cost).
 void BM_ParallelRegion(benchmark::State& st) {
-  for (auto _ : st) for_each_host_share(omp_get_max_threads(), Cost{kParallelWork, 0}, [](Share) {});
+  for (auto _ : st) for_each_host_share("empty region", omp_get_max_threads(), Cost{kParallelWork, 0}, [](Share) {});
   st.counters["omp_threads"] = omp_get_max_threads();
 }
 BENCHMARK(BM_ParallelRegion)->Name("ParallelRegion")->UseRealTime();

@@ -138,11 +138,13 @@ if [[ $stage == first ]]; then
   step 150 60 6-largest large LARGE_LEVELS="${FIRST_LARGEST:-15}"
   # the lines that answer issue 22's bars, step by step: tests passed, the
   # benchmarks' medians, each solve's verdict, work and times, GPU against
-  # CPU, the roofline's device triad and kernels, and every failure
+  # CPU, the roofline's device triad and kernels, each GPU solve's kernels
+  # and copies of 5 % of its time and more, and every failure
   echo "== summary (whole logs above, and in run_first.log where OUT is set)"
   keep='^\[ +(PASSED|FAILED) +\]|_median|^== |largest difference|sets equal|iterations .* vs|same solution|DIFFERENT'
-  keep+='|^(converged|not converged)|^work: .*peak|^times \[s\]|^# device|^(apply y|apply \(float|dot |axpy |cg_update|V-cycle \()'
+  keep+='|^(converged|not converged)|^work: .*peak|^times \[s\]|^# device|^apply y = Kx|^(apply \(float\)|dot|axpy|cg_update) +[0-9]|^V-cycle \('
   keep+='|exit status [1-9]|error|refused'
+  keep+='| (device|copy) +[0-9]+ +[0-9.]+ +([5-9]|[1-9][0-9])\.[0-9]%|^in launches:'  # (kernels of 5 % and more)
   for f in "$out"/*.log; do
     echo "-- ${f##*/}"
     grep -E "$keep" "$f" || true

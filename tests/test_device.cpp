@@ -20,6 +20,7 @@
 #include "core/fem/problem.hpp"
 #include "core/multigrid/interior.hpp"
 #include "core/multigrid/multigrid.hpp"
+#include "core/util/profile.hpp"
 #include "kernels/elasticity.hpp"
 #include "kernels/transfer.hpp"
 #include "kernels/launch.hpp"
@@ -307,6 +308,29 @@ TEST(Device, LaunchesOnTheDeviceAreCountedAndTimed) {
   EXPECT_EQ(b.threaded, a.threaded);
   EXPECT_EQ(b.one_thread, a.one_thread);
   EXPECT_EQ(b.threaded_seconds, a.threaded_seconds);
+  // and by kernel: each launch under its name, as a target region; a field
+  // moved to the device and back under the copies, with its bytes
+  profile_reset();
+  {
+    OnDevice on;
+    axpy(n, 0.5, x.data(), y.data());
+    (void)dot(n, x.data(), y.data());
+  }
+  Field<real> z = on_device(test::random_vector(n, 6));
+  z.move_to(Space::host);
+  const std::vector<KernelLaunches> since = kernel_launches_since_reset();
+  auto find = [&](const std::string& kernel, Ran ran) {
+    for (const KernelLaunches& k : since)
+      if (k.kernel == kernel && k.ran == ran) return k;
+    return KernelLaunches{kernel, ran};
+  };
+  EXPECT_EQ(find("axpy", Ran::device).calls, 1);
+  EXPECT_DOUBLE_EQ(find("axpy", Ran::device).bytes, double(n) * kAxpyCost.bytes);
+  EXPECT_EQ(find("dot", Ran::device).calls, 1);
+  EXPECT_EQ(find("axpy", Ran::threaded).calls + find("axpy", Ran::one_thread).calls, 0);
+  EXPECT_EQ(find("copy host to device", Ran::copy).calls, 1);
+  EXPECT_DOUBLE_EQ(find("copy host to device", Ran::copy).bytes, double(n) * sizeof(real));
+  EXPECT_EQ(find("copy device to host", Ran::copy).calls, 1);
 }
 
 // the stencil apply (its row form on the device), stencil and vectors made

@@ -335,6 +335,36 @@ TEST(TrescaDriver, WritesJsonCsvAndVtk) {
   }
 }
 
+// --profile's launches by kernel: every launch of the run under its
+// kernel's name (the JSON's "kernels": the same calls and seconds as the
+// launch census by where they ran), the float V-cycle's apply among them
+TEST(TrescaDriver, ProfileNamesTheKernelOfEveryLaunch) {
+  const std::string json = std::string(TRESCA_BIN_DIR) + "/../t_kernels.json";
+  const CmdResult r = run("tresca --level 6 --quiet --profile --json " + json);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("launches by kernel"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\napply (float) "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\nin launches: "), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(slurp(json));
+  ASSERT_TRUE(j["kernels"].is_array());
+  long long calls = 0;
+  double seconds = 0, apply_float_bytes = 0;
+  for (const auto& k : j["kernels"]) {
+    if (k["where"] == "copy") continue;
+    calls += k["calls"].get<long long>();
+    seconds += k["seconds"].get<double>();
+    if (k["kernel"] == "apply (float)") apply_float_bytes += k["bytes"].get<double>();
+  }
+  const auto& L = j["launches"];
+  EXPECT_EQ(calls, L["parallel_regions"].get<long long>() + L["one_thread"].get<long long>() +
+                       L["device"].get<long long>());
+  const double census = L["threaded_seconds"].get<double>() + L["one_thread_launch_seconds"].get<double>() +
+                        L["device_seconds"].get<double>();
+  EXPECT_NEAR(seconds, census, 1e-9 * calls + 1e-12 * census);
+  EXPECT_GT(apply_float_bytes, 0);
+  std::remove(json.c_str());
+}
+
 TEST(TrescaDriver, OutputsNeverDestroyWhatTheyDoNotOwn) {
   // issue 11: a special file is written in place, not replaced (as root,
   // --json /dev/null replaced the null device); a symlink at the old fixed

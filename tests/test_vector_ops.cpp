@@ -137,7 +137,7 @@ TEST(Partition, LaunchesGiveEachThreadItsShare) {
   ASSERT_TRUE(worth_threads(double(n) * Cost{8, 0}));
   std::vector<int> owner(std::size_t(n), -1);
   int* o = owner.data();
-  for_each_entry(n, Cost{8, 0}, [=](index i) { o[i] = omp_get_thread_num(); });
+  for_each_entry("owner", n, Cost{8, 0}, [=](index i) { o[i] = omp_get_thread_num(); });
   const index w = omp_get_max_threads();
   for (index t = 0; t < w; ++t)
     for (index c = 0; c < kThirds; ++c) {
@@ -145,7 +145,8 @@ TEST(Partition, LaunchesGiveEachThreadItsShare) {
       for (index i = s.begin; i < s.end; ++i) ASSERT_EQ(owner[std::size_t(i)], t) << "entry " << i;
     }
   const real blocks = sum_over_blocks(
-      n, 1000, Cost{8, 0}, [&](index i0, index i1) { return real(i1 - i0) * (o[i0] == omp_get_thread_num() ? 1 : -1); },
+      "owner sum", n, 1000, Cost{8, 0},
+      [&](index i0, index i1) { return real(i1 - i0) * (o[i0] == omp_get_thread_num() ? 1 : -1); },
       [](index) { return real(1); });
   EXPECT_EQ(blocks, real(n));
 }
@@ -169,6 +170,52 @@ TEST(VectorOps, LaunchesAreCountedByWhereTheyRan) {
   EXPECT_EQ(c.threaded - b.threaded, 0);
   EXPECT_EQ(c.one_thread - b.one_thread, 2);
   EXPECT_EQ(c.device, a.device);
+}
+
+// ... and by kernel: each launch under its kernel's name and where it ran,
+// with its modelled traffic; a float variant under its own name; the
+// profile's census since its reset holds only the launches after it
+TEST(VectorOps, LaunchesAreCountedByKernel) {
+  const index big = 1 << 20, small = 8;
+  const auto x = test::random_vector(big, 17);
+  auto y = test::random_vector(big, 18);
+  const std::vector<float> xf(x.begin(), x.end());
+  auto find = [](const std::vector<KernelLaunches>& all, const std::string& kernel, Ran ran) {
+    for (const KernelLaunches& k : all)
+      if (k.kernel == kernel && k.ran == ran) return k;
+    return KernelLaunches{kernel, ran};
+  };
+  const std::vector<KernelLaunches> a = launches_by_kernel();
+  const LaunchCounts ca = launch_counts();
+  profile_reset();
+  axpy(big, 0.5, x.data(), y.data());
+  axpy(small, 0.5, x.data(), y.data());
+  axpy(small, 0.5, x.data(), y.data());
+  (void)dot(big, xf.data(), xf.data());
+  const std::vector<KernelLaunches> b = launches_by_kernel();
+  const LaunchCounts cb = launch_counts();
+  const KernelLaunches t0 = find(a, "axpy", Ran::threaded), t1 = find(b, "axpy", Ran::threaded);
+  const KernelLaunches o0 = find(a, "axpy", Ran::one_thread), o1 = find(b, "axpy", Ran::one_thread);
+  EXPECT_EQ(t1.calls - t0.calls, 1);
+  EXPECT_DOUBLE_EQ(t1.bytes - t0.bytes, double(big) * kAxpyCost.bytes);
+  EXPECT_DOUBLE_EQ(t1.flops - t0.flops, double(big) * kAxpyCost.flops);
+  EXPECT_EQ(o1.calls - o0.calls, 2);
+  EXPECT_DOUBLE_EQ(o1.bytes - o0.bytes, 2.0 * small * kAxpyCost.bytes);
+  const KernelLaunches f0 = find(a, "dot (float)", Ran::threaded), f1 = find(b, "dot (float)", Ran::threaded);
+  EXPECT_EQ(f1.calls - f0.calls, 1);
+  EXPECT_DOUBLE_EQ(f1.bytes - f0.bytes, double(big) * in_precision<float>(kDotCost).bytes);
+  EXPECT_EQ(find(b, "dot", Ran::threaded).calls, find(a, "dot", Ran::threaded).calls);
+  // the same launches, the same seconds, as the census by where they ran
+  EXPECT_NEAR((t1.seconds - t0.seconds) + (f1.seconds - f0.seconds), cb.threaded_seconds - ca.threaded_seconds, 1e-9);
+  EXPECT_NEAR(o1.seconds - o0.seconds, cb.one_thread_seconds - ca.one_thread_seconds, 1e-9);
+  // since the reset: these three rows only, the longest first
+  const std::vector<KernelLaunches> since = kernel_launches_since_reset();
+  ASSERT_EQ(since.size(), 3u);
+  EXPECT_EQ(find(since, "axpy", Ran::threaded).calls, 1);
+  EXPECT_EQ(find(since, "axpy", Ran::one_thread).calls, 2);
+  EXPECT_EQ(find(since, "dot (float)", Ran::threaded).calls, 1);
+  for (std::size_t i = 1; i < since.size(); ++i) EXPECT_GE(since[i - 1].seconds, since[i].seconds);
+  EXPECT_STREQ(to_string(Ran::one_thread), "1 thread");
 }
 
 // ... and timed: a threaded launch's wall time in threaded_seconds, in the

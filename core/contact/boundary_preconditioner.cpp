@@ -49,7 +49,7 @@ void BoundaryPreconditioner::update(const Field<real>& h_placed, const Field<std
 void BoundaryPreconditioner::apply(const real* r, real* z) const {
   mg_->apply_at(S_.contact_rows(), r, z);
   const std::uint8_t* free = free_.data();
-  for_each_entry(size(), Cost{9, 0}, [=](index i) {
+  for_each_entry("newton-step preconditioner mask", size(), Cost{9, 0}, [=](index i) {
     if (!free[i]) z[i] = 0;
   });
 }

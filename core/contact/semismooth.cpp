@@ -103,7 +103,7 @@ bool linearise(index p, const real* scale, const Point& x, const FrictionLaw& fr
   real *known = L.known.data(), *h = L.h.data(), *rhs = L.rhs.data(), *dlambda = L.dlambda.data(),
        *coupling = L.coupling.data();
   std::uint8_t *fixed = L.fixed.data(), *free = L.free.data();
-  for_each_entry(p, Cost{81, 30}, [=](index i) {
+  for_each_entry("newton-step system", p, Cost{81, 30}, [=](index i) {
     const bool stick = status[i] & kStick, contact = status[i] & kContact;
     const real s = scale ? scale[i] : 1;
     const real v1 = d[i] - u[i], v2 = d[p + i] - u[p + i], v3 = vhat[2 * p + i], v4 = d[2 * p + i] - lambda[i];
@@ -136,7 +136,7 @@ bool linearise(index p, const real* scale, const Point& x, const FrictionLaw& fr
     rhs[i] = r1;
     rhs[p + i] = r2;
   });
-  const real nodes_known = sum_over_entries(p, Cost{24, 0}, [=](index i) {
+  const real nodes_known = sum_over_entries("newton-step known nodes", p, Cost{24, 0}, [=](index i) {
     return real(known[i] != 0 || known[p + i] != 0 || known[2 * p + i] != 0);
   });
   return nodes_known > 0;
@@ -148,7 +148,7 @@ void subtract_known(const ReducedSystem& L, index p, const real* Sk, real* rhs) 
   const real* coupling = L.coupling.data();
   const std::uint8_t* free = L.free.data();
   const bool coupled = L.coupled;
-  for_each_entry(p, Cost{67, 5}, [=](index i) {
+  for_each_entry("newton-step recover", p, Cost{67, 5}, [=](index i) {
     for (int a = 0; a < 3; ++a) {
       const index k = a * p + i;
       if (!free[k]) continue;
@@ -186,7 +186,7 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
     const real *h = L_.h.data(), *coupling = L_.coupling.data();
     const std::uint8_t* free = L_.free.data();
     const bool coupled = L_.coupled;
-    for_each_entry(p, Cost{123, 12}, [=](index i) {
+    for_each_entry("newton-step operator", p, Cost{123, 12}, [=](index i) {
       real y1 = Sx[i] + h[i] * x[i] + h[p + i] * x[p + i];
       real y2 = Sx[p + i] + h[p + i] * x[i] + h[2 * p + i] * x[p + i];
       const real y3 = Sx[2 * p + i];
@@ -531,7 +531,7 @@ bool NewtonSolve::measure(int k) {
         const real F = opt.friction.F;
         const real* d4 = x.d.data() + 2 * p;
         real* phi = x.phi.data();
-        for_each_entry(p, Cost{16, 1}, [=](index i) { phi[i] = F * d4[i]; });
+        for_each_entry("coulomb bound", p, Cost{16, 1}, [=](index i) { phi[i] = F * d4[i]; });
         approximation_step(p, ContactLaw{phi, gap.data(), opt.kink_contact}, scale_ptr, units.data(), x.u.data(),
                            x.lambda.data(), x.r.data(), trial.v.data(), trial.w.data(), x.d.data(), x.status.data());
       }
@@ -610,7 +610,8 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
     const real* known_part = L.dlambda.data();
     const std::uint8_t* status = x.status.data();
     real* dl = dlambda.data();
-    for_each_entry(p, Cost{25, 1}, [=](index i) { dl[i] = known_part[i] + ((status[i] & kContact) ? Sdu[2 * p + i] : 0); });
+    for_each_entry("newton-step dlambda", p, Cost{25, 1},
+                   [=](index i) { dl[i] = known_part[i] + ((status[i] & kContact) ? Sdu[2 * p + i] : 0); });
   }
 
   real alpha = 1;
@@ -618,7 +619,7 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
     alpha = line_search(R.merit, opt.line_search_memory, opt.line_search_halvings, [&](real a) {
       const real *u = x.u.data(), *r = x.r.data(), *lambda = x.lambda.data(), *dU = du.data(), *dl = dlambda.data();
       real *tu = trial.u.data(), *tr = trial.r.data(), *tl = trial.lambda.data();
-      for_each_entry(p, Cost{128, 14}, [=](index i) {
+      for_each_entry("line search trial", p, Cost{128, 14}, [=](index i) {
         for (int c = 0; c < 3; ++c) {
           tu[c * p + i] = u[c * p + i] + a * dU[c * p + i];
           tr[c * p + i] = r[c * p + i] + a * Sdu[c * p + i];

@@ -31,7 +31,7 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
   {
     const index N = box().nodes(), nx = box().nx(), row0 = slab().y_begin - slab().lo, c0 = c_begin_, p = p_;
     index* rows = rows_.data();
-    for_each_entry(p, Cost{24, 0}, [=](index k) {
+    for_each_entry("contact rows", p, Cost{24, 0}, [=](index k) {
       const index c = c0 + k, node = 1 + c % ex + nx * (c / ex - row0);
       for (int a = 0; a < 3; ++a) rows[a * p + k] = a * N + node;
     });

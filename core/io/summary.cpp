@@ -113,6 +113,16 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                        {"flops_per_s", r.flops_per_s},
                        {"parallel", r.parallel}});
   j["profile"] = profile;
+  // every kernel's launches (kernels/launch.hpp, launches_by_kernel), the longest first
+  Json kernels = Json::array();
+  for (const KernelLaunches& k : kernel_launches_since_reset())
+    kernels.push_back({{"kernel", k.kernel},
+                       {"where", to_string(k.ran)},
+                       {"calls", k.calls},
+                       {"seconds", k.seconds},
+                       {"bytes", k.bytes},
+                       {"flops", k.flops}});
+  j["kernels"] = kernels;
   // the launches of the run (kernels/launch.hpp): what ran threaded, what on one thread
   const LaunchCounts L = launches_since_reset();
   Json by_size = Json::array();

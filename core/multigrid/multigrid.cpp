@@ -274,7 +274,7 @@ void Multigrid::estimate_lmax(int l) {
     HostLaunches host;
     r = Field<T>(std::size_t(n));
     T* start = r.data();
-    for_each_host_block(3 * nz * ny, double(n) * Cost{8, 4}, [=, &G, &box](index row) {
+    for_each_host_block("random start vector", 3 * nz * ny, double(n) * Cost{8, 4}, [=, &G, &box](index row) {
       const index c = row / (nz * ny), iz = (row / ny) % nz, j = row % ny;
       const index k0 = c * G.nodes() + G.node(0, row0 + j, iz);
       std::uint64_t s = Lcg::jump(12345, std::uint64_t(k0) + 1);

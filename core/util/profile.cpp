@@ -16,6 +16,7 @@ namespace tresca {
 namespace {
 ProfileEntry g_entries[int(Kernel::count)];
 LaunchCounts g_launches_at_reset;  // the launch census when the profile was last reset
+std::vector<KernelLaunches> g_kernels_at_reset;  // and the census by kernel
 // the seconds in launches that ran in parallel: host parallel regions and target regions
 double parallel_seconds(const LaunchCounts& c) { return c.threaded_seconds + c.device_seconds; }
 double parallel_seconds_so_far() { return parallel_seconds(launch_counts()); }
@@ -82,6 +83,24 @@ ScopedTimer::~ScopedTimer() {
 void profile_reset() {
   for (ProfileEntry& e : g_entries) e = ProfileEntry{};
   g_launches_at_reset = launch_counts();
+  g_kernels_at_reset = launches_by_kernel();
+}
+
+std::vector<KernelLaunches> kernel_launches_since_reset() {
+  std::vector<KernelLaunches> out;
+  for (KernelLaunches k : launches_by_kernel()) {
+    for (const KernelLaunches& r : g_kernels_at_reset)
+      if (r.kernel == k.kernel && r.ran == k.ran) {
+        k.calls -= r.calls;
+        k.seconds -= r.seconds;
+        k.bytes -= r.bytes;
+        k.flops -= r.flops;
+      }
+    if (k.calls > 0) out.push_back(k);
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const KernelLaunches& a, const KernelLaunches& b) { return a.seconds > b.seconds; });
+  return out;
 }
 
 LaunchCounts launches_since_reset() {
@@ -135,6 +154,52 @@ std::vector<ProfileRow> profile_rows(double total) {
   return rows;
 }
 
+namespace {
+// the launches by kernel: the longest first, down to a thousandth of the
+// run, the rest in one line
+std::string kernel_launch_table(double total) {
+  const std::vector<KernelLaunches> kernels = kernel_launches_since_reset();
+  if (kernels.empty()) return "";
+  std::string out = "\nlaunches by kernel (every launch of the run; where: threads = a parallel region, 1 thread = work\n"
+                    " below worth_threads, device = a target region, copy = between host and device memory)\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "%-32s %-8s %8s %10s %7s %9s %9s %9s\n", "kernel", "where", "calls", "time [s]",
+                "share", "us/call", "GB/s", "GFLOP/s");
+  out += line;
+  double in_launches = 0, rest = 0;
+  long long rest_calls = 0, rest_rows = 0;
+  for (const KernelLaunches& k : kernels) {
+    in_launches += k.seconds;
+    if (total > 0 && k.seconds < 1e-3 * total) {
+      rest += k.seconds;
+      rest_calls += k.calls;
+      ++rest_rows;
+      continue;
+    }
+    char gbs[16] = "-", gflops[16] = "-";
+    if (k.seconds > 0 && k.bytes > 0) std::snprintf(gbs, sizeof gbs, "%.2f", k.bytes / k.seconds * 1e-9);
+    if (k.seconds > 0 && k.flops > 0) std::snprintf(gflops, sizeof gflops, "%.2f", k.flops / k.seconds * 1e-9);
+    std::snprintf(line, sizeof line, "%-32s %-8s %8lld %10.3f %6.1f%% %9.1f %9s %9s\n", k.kernel.c_str(),
+                  to_string(k.ran), k.calls, k.seconds, total > 0 ? 100 * k.seconds / total : 0.0,
+                  1e6 * k.seconds / double(k.calls), gbs, gflops);
+    out += line;
+  }
+  if (rest_rows > 0) {
+    std::snprintf(line, sizeof line, "(%lld more, each under 0.1 %% of the run: %lld calls, %.3f s)\n", rest_rows,
+                  rest_calls, rest);
+    out += line;
+  }
+  if (total > 0) {
+    std::snprintf(line, sizeof line,
+                  "in launches: %.3f s of the %.3f s (%.1f %%); GB/s and GFLOP/s from the kernels' modelled "
+                  "traffic and flops\n",
+                  in_launches, total, 100 * in_launches / total);
+    out += line;
+  }
+  return out;
+}
+}  // namespace
+
 std::string profile_table(double total) {
   std::string out;
   char line[256];
@@ -155,6 +220,7 @@ std::string profile_table(double total) {
   out += "(time: the row's whole time; self: less the rows timed inside it, e.g. the smoother less its\n"
          " applies; share: self / total, so the shares add up to 100 %; other: outside every timer;\n"
          " parallel: the part of self inside parallel regions (or on the device), the rest ran on one thread)\n";
+  out += kernel_launch_table(total);
   // Amdahl's part: what more threads leave as it is
   const LaunchCounts since = launches_since_reset();
   if (total > 0) {

@@ -43,10 +43,15 @@ void profile_reset();
 // one thread and on the device
 struct LaunchCounts;
 LaunchCounts launches_since_reset();
+struct KernelLaunches;
 // of a run of `total` seconds since the last profile_reset, the part outside
 // every parallel region and target region: what ran on one host thread
 double one_thread_seconds(double total);
-// the rows as a table: calls, time, self time, share, GB/s and GFLOP/s
+// every kernel's launches since the last profile_reset (launches_by_kernel,
+// kernels/launch.hpp), each (kernel, where it ran) once, the longest first
+std::vector<KernelLaunches> kernel_launches_since_reset();
+// the rows as a table: calls, time, self time, share, GB/s and GFLOP/s; then
+// the launches by kernel, and the launch census
 std::string profile_table(double total_seconds);
 
 double wall_time();
