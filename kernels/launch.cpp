@@ -39,37 +39,25 @@ bool offload_built() {
 
 bool launch_on_device() { return on_device; }
 
-std::atomic<long long> detail::launches[3];
-std::atomic<long long> detail::launch_ns[3];
 namespace {
-constexpr int kSizes = LaunchCounts::kSizes;
-std::atomic<long long> launches_by_size[kSizes], launch_ns_by_size[kSizes];
-std::atomic<double> work_by_size[kSizes];
-}  // namespace
-
-void detail::count_threaded_launch(double work, long long ns) {
-  const int k = work < 10 * kParallelWork ? 0 : work < 100 * kParallelWork ? 1 : 2;
-  static_assert(kSizes == 3, "the size classes above");
-  launches[0].fetch_add(1, std::memory_order_relaxed);
-  launch_ns[0].fetch_add(ns, std::memory_order_relaxed);
-  launches_by_size[k].fetch_add(1, std::memory_order_relaxed);
-  launch_ns_by_size[k].fetch_add(ns, std::memory_order_relaxed);
-  double w = work_by_size[k].load(std::memory_order_relaxed);  // (one caller at a time: no lost update to fear)
-  work_by_size[k].store(w + work, std::memory_order_relaxed);
-}
-
-namespace {
-// the census by kernel: a slot per kernel name, its counts by where they ran
+// the census: a slot per kernel name, its counts by where they ran, and the
+// totals of LaunchCounts, all under one lock (launches come from the
+// driver's thread; the lock keeps a stray one from another safe)
 struct KernelSlot {
   const char* kernel;
   long long calls[int(Ran::count)] = {};
   long long ns[int(Ran::count)] = {};
   double bytes[int(Ran::count)] = {}, flops[int(Ran::count)] = {};
 };
-std::mutex kernel_slots_mutex;
-std::vector<KernelSlot>& kernel_slots() {
-  static std::vector<KernelSlot> slots;
-  return slots;
+struct Census {
+  std::mutex mutex;
+  std::vector<KernelSlot> slots;
+  LaunchCounts totals;
+  long long ns[3] = {}, ns_by_size[LaunchCounts::kSizes] = {};  // (threaded, one_thread, device)
+};
+Census& census() {
+  static Census c;
+  return c;
 }
 }  // namespace
 
@@ -78,44 +66,64 @@ const char* to_string(Ran r) {
   return names[int(r)];
 }
 
-void detail::count_kernel(const char* kernel, Ran ran, Cost work, long long ns) {
-  const std::lock_guard<std::mutex> lock(kernel_slots_mutex);
-  std::vector<KernelSlot>& slots = kernel_slots();
+void detail::count_launch(const char* kernel, Ran ran, Cost work, long long ns) {
+  Census& c = census();
+  const std::lock_guard<std::mutex> lock(c.mutex);
   // a name is a string literal: the same pointer, or the same text where
   // two translation units each hold a copy of it
-  auto s = std::find_if(slots.begin(), slots.end(),
+  auto s = std::find_if(c.slots.begin(), c.slots.end(),
                         [&](const KernelSlot& k) { return k.kernel == kernel || !std::strcmp(k.kernel, kernel); });
-  if (s == slots.end()) s = slots.insert(slots.end(), KernelSlot{kernel});
+  if (s == c.slots.end()) s = c.slots.insert(c.slots.end(), KernelSlot{kernel});
   const int r = int(ran);
   s->calls[r] += 1;
   s->ns[r] += ns;
   s->bytes[r] += work.bytes;
   s->flops[r] += work.flops;
+  LaunchCounts& t = c.totals;
+  switch (ran) {
+    case Ran::threaded: {
+      const double w = work.bytes + work.flops;
+      const int k = w < 10 * kParallelWork ? 0 : w < 100 * kParallelWork ? 1 : 2;
+      static_assert(LaunchCounts::kSizes == 3, "the size classes above");
+      t.threaded += 1;
+      c.ns[0] += ns;
+      t.by_size[k] += 1;
+      c.ns_by_size[k] += ns;
+      t.by_size_work[k] += w;
+      break;
+    }
+    case Ran::one_thread:
+      t.one_thread += 1;
+      c.ns[1] += ns;
+      break;
+    case Ran::device:
+      t.device += 1;
+      c.ns[2] += ns;
+      break;
+    default:  // (copies are no launch)
+      break;
+  }
 }
 
 std::vector<KernelLaunches> launches_by_kernel() {
-  const std::lock_guard<std::mutex> lock(kernel_slots_mutex);
+  Census& c = census();
+  const std::lock_guard<std::mutex> lock(c.mutex);
   std::vector<KernelLaunches> out;
-  for (const KernelSlot& s : kernel_slots())
+  for (const KernelSlot& s : c.slots)
     for (int r = 0; r < int(Ran::count); ++r)
       if (s.calls[r] > 0) out.push_back({s.kernel, Ran(r), s.calls[r], 1e-9 * double(s.ns[r]), s.bytes[r], s.flops[r]});
   return out;
 }
 
 LaunchCounts launch_counts() {
-  LaunchCounts c;
-  c.threaded = detail::launches[0].load();
-  c.one_thread = detail::launches[1].load();
-  c.device = detail::launches[2].load();
-  c.threaded_seconds = 1e-9 * double(detail::launch_ns[0].load());
-  c.one_thread_seconds = 1e-9 * double(detail::launch_ns[1].load());
-  c.device_seconds = 1e-9 * double(detail::launch_ns[2].load());
-  for (int k = 0; k < kSizes; ++k) {
-    c.by_size[k] = launches_by_size[k].load();
-    c.by_size_seconds[k] = 1e-9 * double(launch_ns_by_size[k].load());
-    c.by_size_work[k] = work_by_size[k].load();
-  }
-  return c;
+  Census& c = census();
+  const std::lock_guard<std::mutex> lock(c.mutex);
+  LaunchCounts t = c.totals;
+  t.threaded_seconds = 1e-9 * double(c.ns[0]);
+  t.one_thread_seconds = 1e-9 * double(c.ns[1]);
+  t.device_seconds = 1e-9 * double(c.ns[2]);
+  for (int k = 0; k < LaunchCounts::kSizes; ++k) t.by_size_seconds[k] = 1e-9 * double(c.ns_by_size[k]);
+  return t;
 }
 
 void set_launch_on_device(bool on) {
@@ -414,7 +422,7 @@ void space_copy(Space to_space, void* to, Space from_space, const void* from, st
   const char* kernel = from_space == Space::host ? "copy host to device"
                        : to_space == Space::host ? "copy device to host"
                                                  : "copy device to device";
-  detail::count_kernel(kernel, Ran::copy, Cost{double(bytes), 0}, detail::now_ns() - t0);
+  detail::count_launch(kernel, Ran::copy, Cost{double(bytes), 0}, detail::now_ns() - t0);
 }
 
 void space_zero(Space s, void* p, std::size_t bytes) {

@@ -26,7 +26,6 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <string>
 #include <vector>
@@ -178,14 +177,14 @@ constexpr const char* precision_name(const char* as_double, const char* as_float
 }
 
 namespace detail {
-extern std::atomic<long long> launches[3];  // threaded, one_thread, device
-extern std::atomic<long long> launch_ns[3];  // threaded, one_thread, device
 inline long long now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
-void count_threaded_launch(double work, long long ns);  // in its size class
-void count_kernel(const char* kernel, Ran ran, Cost work, long long ns);  // in launches_by_kernel
+// one launch (or copy) of `kernel` that ran where `ran` says and took ns:
+// in launch_counts (a threaded one in its size class too) and in
+// launches_by_kernel
+void count_launch(const char* kernel, Ran ran, Cost work, long long ns);
 // One host launch of a kernel: whether it starts threads
 // (worth_threads(work)), counted as what it is and timed until it goes out
 // of scope. Host launches are made from the driver's thread only (none
@@ -194,16 +193,7 @@ class HostLaunch {
  public:
   HostLaunch(const char* kernel, Cost work)
       : threads(worth_threads(work)), kernel_(kernel), work_(work), t0_(now_ns()) {}
-  ~HostLaunch() {
-    const long long ns = now_ns() - t0_;
-    if (threads)
-      count_threaded_launch(work_.bytes + work_.flops, ns);
-    else {
-      launches[1].fetch_add(1, std::memory_order_relaxed);
-      launch_ns[1].fetch_add(ns, std::memory_order_relaxed);
-    }
-    count_kernel(kernel_, threads ? Ran::threaded : Ran::one_thread, work_, ns);
-  }
+  ~HostLaunch() { count_launch(kernel_, threads ? Ran::threaded : Ran::one_thread, work_, now_ns() - t0_); }
   HostLaunch(const HostLaunch&) = delete;
   HostLaunch& operator=(const HostLaunch&) = delete;
   const bool threads;
@@ -217,12 +207,7 @@ class HostLaunch {
 class DeviceLaunch {
  public:
   DeviceLaunch(const char* kernel, Cost work) : kernel_(kernel), work_(work), t0_(now_ns()) {}
-  ~DeviceLaunch() {
-    const long long ns = now_ns() - t0_;
-    launches[2].fetch_add(1, std::memory_order_relaxed);
-    launch_ns[2].fetch_add(ns, std::memory_order_relaxed);
-    count_kernel(kernel_, Ran::device, work_, ns);
-  }
+  ~DeviceLaunch() { count_launch(kernel_, Ran::device, work_, now_ns() - t0_); }
   DeviceLaunch(const DeviceLaunch&) = delete;
   DeviceLaunch& operator=(const DeviceLaunch&) = delete;
 
