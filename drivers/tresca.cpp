@@ -78,7 +78,7 @@ const char* kHelp =
     "                     of the fine mesh and FILE.pvd to play them in ParaView (one extra S apply each)\n"
     "  --vtk-format binary|ascii  VTU encoding: LZMA-compressed appended binary (default) or text\n"
     "  --table A-B        solve levels A..B and print the paper's Table 1 columns\n"
-    "  --profile          per-kernel time, GB/s and GFLOP/s after the run\n"
+    "  --profile          after the run, time, GB/s and GFLOP/s by solver phase and by kernel launched\n"
     "  --quiet            no progress lines\n"
     "  -h, --help         this text;  --version  the version and the build (ISA, compiler)\n"
     "A run is converged only if its final KKT check agrees (else reason kkt_check_failed).\n"
