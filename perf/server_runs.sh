@@ -7,7 +7,8 @@
 # STAGE:
 #   threads   level 12 with all cores as threads (libgomp's default wait,
 #             OMP_WAIT_POLICY=active, passive; each placed close on cores)
-#             and as MPI ranks: issue 21's "16 threads within 10 % of 16 ranks"
+#             and as MPI ranks: issue 21's "16 threads within 10 % of 16 ranks";
+#             then its kernels of 2 % and more with all cores (--profile)
 #   scaling   scaling --threads 1,2,4,8,16 on levels 10-12: speed-up and
 #             efficiency against the bandwidth-ideal speed-up
 #   ranks     scaling --ranks 1,2,4,8,16 on level 12
@@ -59,7 +60,11 @@ case $stage in
       for rep in 1 2 3; do
         KEEP=$solve run mpirun -np "$T" --bind-to core -x OMP_NUM_THREADS=1 "$b/bin/tresca" --level "$L" --quiet
       done
-    fi ;;
+    fi
+    # where the threads' time goes: the kernels of 2 % of the run and more,
+    # each with its GB/s (issue 21's bandwidth bar), and the serial part
+    KEEP="$solve|^kernel +where| (threads|1 thread) +[0-9]+ +[0-9.]+ +([2-9]|[1-9][0-9])\.[0-9]%|^in launches|^one thread" \
+      run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores "$b/bin/tresca" --level "$L" --quiet --profile ;;
   scaling)
     TAIL=40 run env OMP_PROC_BIND=close OMP_PLACES=cores "$b/bin/scaling" --levels "$LS" --threads "${SWEEP:-1,2,4,8,16}" ;;
   ranks)
@@ -73,7 +78,7 @@ case $stage in
     done ;;
   profile)
     for t in 1 "$T"; do
-      TAIL=22 run env OMP_NUM_THREADS="$t" OMP_PROC_BIND=close OMP_PLACES=cores "$b/bin/tresca" --level "$L" --quiet --profile
+      TAIL=75 run env OMP_NUM_THREADS="$t" OMP_PROC_BIND=close OMP_PLACES=cores "$b/bin/tresca" --level "$L" --quiet --profile
     done
     KEEP='^(ParallelRegion|VCycle)' run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores \
       "$b/bin/bench_kernels" --benchmark_filter='ParallelRegion|^VCycle/10' ;;
