@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <chrono>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace tresca {
@@ -173,7 +174,7 @@ std::vector<KernelLaunches> launches_by_kernel();
 // a template kernel's name in the census: its float variant's says so
 template <class T>
 constexpr const char* precision_name(const char* as_double, const char* as_float) {
-  return sizeof(T) == sizeof(float) ? as_float : as_double;
+  return std::is_same_v<T, float> ? as_float : as_double;
 }
 
 namespace detail {
