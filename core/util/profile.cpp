@@ -160,8 +160,9 @@ namespace {
 std::string kernel_launch_table(double total) {
   const std::vector<KernelLaunches> kernels = kernel_launches_since_reset();
   if (kernels.empty()) return "";
-  std::string out = "\nlaunches by kernel (every launch of the run; where: threads = a parallel region, 1 thread = work\n"
-                    " below worth_threads, device = a target region, copy = between host and device memory)\n";
+  std::string out =
+      "\nlaunches by kernel (every launch of the run; where: threads = a parallel region, 1 thread = work\n"
+      " below worth_threads, device = a target region, copy = between host and device memory)\n";
   char line[256];
   std::snprintf(line, sizeof line, "%-32s %-8s %8s %10s %7s %9s %9s %9s\n", "kernel", "where", "calls", "time [s]",
                 "share", "us/call", "GB/s", "GFLOP/s");
