@@ -40,9 +40,10 @@ bool offload_built() {
 bool launch_on_device() { return on_device; }
 
 namespace {
-// the census: a slot per kernel name, its counts by where they ran, and the
-// totals of LaunchCounts, all under one lock (launches come from the
-// driver's thread; the lock keeps a stray one from another safe)
+// the census: a slot per kernel name with its counts by where they ran, and
+// the threaded launches by size class; LaunchCounts' totals are the slots'
+// sums. All under one lock (launches come from the driver's thread; the
+// lock keeps a stray one from another safe).
 struct KernelSlot {
   const char* kernel;
   long long calls[int(Ran::count)] = {};
@@ -52,8 +53,8 @@ struct KernelSlot {
 struct Census {
   std::mutex mutex;
   std::vector<KernelSlot> slots;
-  LaunchCounts totals;
-  long long ns[3] = {}, ns_by_size[LaunchCounts::kSizes] = {};  // (threaded, one_thread, device)
+  long long by_size[LaunchCounts::kSizes] = {}, ns_by_size[LaunchCounts::kSizes] = {};
+  double work_by_size[LaunchCounts::kSizes] = {};
 };
 Census& census() {
   static Census c;
@@ -79,29 +80,13 @@ void detail::count_launch(const char* kernel, Ran ran, Cost work, long long ns) 
   s->ns[r] += ns;
   s->bytes[r] += work.bytes;
   s->flops[r] += work.flops;
-  LaunchCounts& t = c.totals;
-  switch (ran) {
-    case Ran::threaded: {
-      const double w = work.bytes + work.flops;
-      const int k = w < 10 * kParallelWork ? 0 : w < 100 * kParallelWork ? 1 : 2;
-      static_assert(LaunchCounts::kSizes == 3, "the size classes above");
-      t.threaded += 1;
-      c.ns[0] += ns;
-      t.by_size[k] += 1;
-      c.ns_by_size[k] += ns;
-      t.by_size_work[k] += w;
-      break;
-    }
-    case Ran::one_thread:
-      t.one_thread += 1;
-      c.ns[1] += ns;
-      break;
-    case Ran::device:
-      t.device += 1;
-      c.ns[2] += ns;
-      break;
-    default:  // (copies are no launch)
-      break;
+  if (ran == Ran::threaded) {
+    const double w = work.bytes + work.flops;
+    const int k = w < 10 * kParallelWork ? 0 : w < 100 * kParallelWork ? 1 : 2;
+    static_assert(LaunchCounts::kSizes == 3, "the size classes above");
+    c.by_size[k] += 1;
+    c.ns_by_size[k] += ns;
+    c.work_by_size[k] += w;
   }
 }
 
@@ -118,11 +103,22 @@ std::vector<KernelLaunches> launches_by_kernel() {
 LaunchCounts launch_counts() {
   Census& c = census();
   const std::lock_guard<std::mutex> lock(c.mutex);
-  LaunchCounts t = c.totals;
-  t.threaded_seconds = 1e-9 * double(c.ns[0]);
-  t.one_thread_seconds = 1e-9 * double(c.ns[1]);
-  t.device_seconds = 1e-9 * double(c.ns[2]);
-  for (int k = 0; k < LaunchCounts::kSizes; ++k) t.by_size_seconds[k] = 1e-9 * double(c.ns_by_size[k]);
+  LaunchCounts t;
+  long long ns[3] = {};  // (threaded, one_thread, device; copies are no launch)
+  for (const KernelSlot& s : c.slots) {
+    t.threaded += s.calls[int(Ran::threaded)];
+    t.one_thread += s.calls[int(Ran::one_thread)];
+    t.device += s.calls[int(Ran::device)];
+    for (int r = 0; r < 3; ++r) ns[r] += s.ns[r];
+  }
+  t.threaded_seconds = 1e-9 * double(ns[int(Ran::threaded)]);
+  t.one_thread_seconds = 1e-9 * double(ns[int(Ran::one_thread)]);
+  t.device_seconds = 1e-9 * double(ns[int(Ran::device)]);
+  for (int k = 0; k < LaunchCounts::kSizes; ++k) {
+    t.by_size[k] = c.by_size[k];
+    t.by_size_seconds[k] = 1e-9 * double(c.ns_by_size[k]);
+    t.by_size_work[k] = c.work_by_size[k];
+  }
   return t;
 }
 

@@ -319,11 +319,7 @@ TEST(Device, LaunchesOnTheDeviceAreCountedAndTimed) {
   Field<real> z = on_device(test::random_vector(n, 6));
   z.move_to(Space::host);
   const std::vector<KernelLaunches> since = kernel_launches_since_reset();
-  auto find = [&](const std::string& kernel, Ran ran) {
-    for (const KernelLaunches& k : since)
-      if (k.kernel == kernel && k.ran == ran) return k;
-    return KernelLaunches{kernel, ran};
-  };
+  auto find = [&](const std::string& kernel, Ran ran) { return test::launches_of(since, kernel, ran); };
   EXPECT_EQ(find("axpy", Ran::device).calls, 1);
   EXPECT_DOUBLE_EQ(find("axpy", Ran::device).bytes, double(n) * kAxpyCost.bytes);
   EXPECT_EQ(find("dot", Ran::device).calls, 1);

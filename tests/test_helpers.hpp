@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "kernels/grid.hpp"
 #include "kernels/isa.hpp"
+#include "kernels/launch.hpp"
 #include "kernels/types.hpp"
 
 namespace tresca::test {
@@ -23,6 +25,14 @@ inline GridDims prism(index ex, index ey, index ez) {
   g.ly = 1;
   g.lz = 0.9;
   return g;
+}
+
+// the launches of `kernel` that ran where `ran` says, in a census by kernel
+// (launches_by_kernel); none (0 calls) where it has no such row
+inline KernelLaunches launches_of(const std::vector<KernelLaunches>& all, const std::string& kernel, Ran ran) {
+  for (const KernelLaunches& k : all)
+    if (k.kernel == kernel && k.ran == ran) return k;
+  return KernelLaunches{kernel, ran};
 }
 
 inline std::vector<real> random_vector(index n, std::uint64_t seed = 1) {

@@ -180,11 +180,7 @@ TEST(VectorOps, LaunchesAreCountedByKernel) {
   const auto x = test::random_vector(big, 17);
   auto y = test::random_vector(big, 18);
   const std::vector<float> xf(x.begin(), x.end());
-  auto find = [](const std::vector<KernelLaunches>& all, const std::string& kernel, Ran ran) {
-    for (const KernelLaunches& k : all)
-      if (k.kernel == kernel && k.ran == ran) return k;
-    return KernelLaunches{kernel, ran};
-  };
+  const auto& find = test::launches_of;
   const std::vector<KernelLaunches> a = launches_by_kernel();
   const LaunchCounts ca = launch_counts();
   profile_reset();
