@@ -36,15 +36,31 @@ Interp1D build_axis(index ef, index ec) {
     }
     a.tstart.push_back(index(a.tf.size()));
   }
+  a.halving = nf >= 2 * nc - 2;
+  a.pair_w.resize(2 * nc + 2);
+  for (index i = 0; i < nf && a.halving; ++i) {
+    if (a.j0[i] == i / 2)
+      a.pair_w[i + 2] = a.w[i];
+    else  // (the last node as coarse node i/2, if that is its only one)
+      a.halving = i == nf - 1 && a.j0[i] == i / 2 - 1 && a.w[i] == 1;
+  }
+  if (!a.halving) a.pair_w = Field<real>();
   return a;
 }
 
 // an axis's arrays as plain pointers (captured by value in the launches)
 struct AxisView {
   const index *j0, *tstart, *tf;
-  const real *w, *tw;
+  const real *w, *tw, *pw;  // pw: pair_w, pw[i] for i in [-2, 2 nc) (halving only)
+  bool halving;
   explicit AxisView(const Interp1D& a)
-      : j0(a.j0.data()), tstart(a.tstart.data()), tf(a.tf.data()), w(a.w.data()), tw(a.tw.data()) {}
+      : j0(a.j0.data()),
+        tstart(a.tstart.data()),
+        tf(a.tf.data()),
+        w(a.w.data()),
+        tw(a.tw.data()),
+        pw(a.halving ? a.pair_w.data() + 2 : nullptr),
+        halving(a.halving) {}
 };
 
 }  // namespace
@@ -96,13 +112,17 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, const T*
   // Per fine row (iy, iz): combine the 4 coarse rows of its y/z support into
   // one coarse-length row buffer (contiguous, vectorised), then interpolate
   // along x from that buffer (it sits in L1): 4 FMAs per coarse node plus
-  // 2 per fine node, instead of 8 coarse reads per fine node.
+  // 2 per fine node, instead of 8 coarse reads per fine node. Along a
+  // halving x axis fine nodes 2k and 2k+1 both lie between s[k] and s[k+1]:
+  // a lane per pair, contiguous reads (the general axis reads s[j0[ix]],
+  // which the CPU runs as scalar code).
   const GridDims &f = t.fine, &c = t.coarse;
   const index Nf = f.nodes(), Nc = c.nodes(), cnx = c.nx(), cny = c.ny(), fnx = f.nx();
   const index fny = f.ny();
   const AxisView X(t.axis[0]), Y(t.axis[1]), Z(t.axis[2]);
-  // one fine row (iy, iz); s: a coarse row of the worker's own
-  const auto fine_row = [=](index iz, index iy, T* s) {
+  // component a's fine row (iy, iz); s: a coarse row of the worker's own,
+  // and one entry
+  const auto fine_row = [=](index a, index iz, index iy, T* s) {
     // 0 on the faces in zero_faces, as a select per entry: on the device no
     // lane writes another lane's entry
     const ConstrainedRow m(f, zero_faces, iy, iz);
@@ -110,24 +130,43 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, const T*
     const T wz = T(Z.w[iz]), wy = T(Y.w[iy]);
     const T w00 = (1 - wy) * (1 - wz), w10 = wy * (1 - wz), w01 = (1 - wy) * wz, w11 = wy * wz;
     const index b00 = cnx * (jy + cny * jz), b10 = b00 + cnx, b01 = b00 + cnx * cny, b11 = b01 + cnx;
-    for (int a = 0; a < comps; ++a) {
-      const T* u = coarse + a * Nc;
+    const T* u = coarse + a * Nc;
 #pragma omp simd
-      for (index j = 0; j < cnx; ++j) s[j] = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
-      const index at = a * Nf + fnx * (iy + fny * iz);
-      T* v = fine + at;
-      const T* v0 = base ? base + at : nullptr;
-      TRESCA_DEVICE_LANES
-      for (index ix = 0; ix < fnx; ++ix) {
-        const index j = X.j0[ix];
-        const T wx = T(X.w[ix]);
-        const T p = (v0 ? v0[ix] : T(0)) + (1 - wx) * s[j] + wx * s[j + 1];
-        v[ix] = m.at(ix) ? T(0) : p;
+    for (index j = 0; j < cnx; ++j) s[j] = w00 * u[b00 + j] + w10 * u[b10 + j] + w01 * u[b01 + j] + w11 * u[b11 + j];
+    const index at = a * Nf + fnx * (iy + fny * iz);
+    T* v = fine + at;
+    const T* v0 = base ? base + at : nullptr;
+    if (X.halving) {
+      // the pairs, then a last node of its own where fnx is odd (a nested
+      // axis's last fine node: weight 0 on s[cnx])
+      s[cnx] = 0;
+#pragma omp simd
+      for (index k = 0; k < fnx / 2; ++k) {
+        const index i = 2 * k;
+        const T a0 = s[k], a1 = s[k + 1], w0 = T(X.pw[i]), w1 = T(X.pw[i + 1]);
+        const T p0 = (v0 ? v0[i] : T(0)) + (1 - w0) * a0 + w0 * a1;
+        const T p1 = (v0 ? v0[i + 1] : T(0)) + (1 - w1) * a0 + w1 * a1;
+        v[i] = m.at(i) ? T(0) : p0;
+        v[i + 1] = m.at(i + 1) ? T(0) : p1;
       }
+      if (fnx % 2) {
+        const index i = fnx - 1, k = i / 2;
+        const T wx = T(X.pw[i]);
+        const T p = (v0 ? v0[i] : T(0)) + (1 - wx) * s[k] + wx * s[k + 1];
+        v[i] = m.at(i) ? T(0) : p;
+      }
+      return;
+    }
+    TRESCA_DEVICE_LANES
+    for (index ix = 0; ix < fnx; ++ix) {
+      const index j = X.j0[ix];
+      const T wx = T(X.w[ix]);
+      const T p = (v0 ? v0[ix] : T(0)) + (1 - wx) * s[j] + wx * s[j + 1];
+      v[ix] = m.at(ix) ? T(0) : p;
     }
   };
-  for_each_block_with_scratch<T>(precision_name<T>("prolongation", "prolongation (float)"), f.nz(), f.ny(), cnx,
-                                 double(comps) * double(Nf) * in_precision<T>(kProlongateCost), fine_row);
+  for_each_block_with_scratch<T>(precision_name<T>("prolongation", "prolongation (float)"), comps, f.nz(), f.ny(),
+                                 cnx + 1, double(comps) * double(Nf) * in_precision<T>(kProlongateCost), fine_row);
 }
 
 template void prolongate<double>(const Transfer&, int, const double*, double*, const double*, unsigned);
@@ -157,35 +196,69 @@ template <class T>
 void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse, unsigned zero_faces) {
   TRESCA_ASSERT(comps >= 1 && comps <= 3 && index(t.axis[0].tstart.size()) == t.coarse.nx() + 1);
   // Per coarse row (jy, jz): sum the weighted fine rows of its y/z support
-  // into one row buffer (contiguous, vectorisable), then gather along x.
+  // (4 to 16 of them) into one row buffer, four rows a pass (contiguous,
+  // vectorised; one pass a row took 30 % longer), then gather along x:
+  // along a halving axis coarse node j takes fine pair j's share of its
+  // first coarse node and pair j-1's of its second (a lane per coarse node,
+  // contiguous reads; the buffer has two zero entries each side), along
+  // the general axis the transposed lists (scalar code on the CPU).
   const GridDims &f = t.fine, &c = t.coarse;
   const index Nf = f.nodes(), Nc = c.nodes(), fnx = f.nx();
   const index fny = f.ny(), cnx = c.nx(), cny = c.ny();
   const AxisView X(t.axis[0]), Y(t.axis[1]), Z(t.axis[2]);
-  // one coarse row (jy, jz); acc: a fine row of the worker's own
-  const auto coarse_row = [=](index jz, index jy, T* acc) {
-    const ConstrainedRow m(c, zero_faces, jy, jz);
-    for (int a = 0; a < comps; ++a) {
+  // component a's coarse row (jy, jz); acc: a fine row of the worker's own,
+  // 2 entries more each side
+  const auto coarse_row = [=](index a, index jz, index jy, T* buffer) {
+    T* acc = buffer + 2;
+    acc[-2] = acc[-1] = acc[fnx] = acc[fnx + 1] = 0;
+    // the fine rows of its y/z support: (y0 + q % ny, z0 + q / ny), q < rows
+    const index y0 = Y.tstart[jy], ny = Y.tstart[jy + 1] - y0, z0 = Z.tstart[jz];
+    const index rows = ny * (Z.tstart[jz + 1] - z0);
+    // four to a pass (the last pass's missing rows: its first again, weight
+    // 0), the first pass writing acc
+    if (rows == 0) {
 #pragma omp simd
       for (index i = 0; i < fnx; ++i) acc[i] = 0;
-      for (index kz = Z.tstart[jz]; kz < Z.tstart[jz + 1]; ++kz)
-        for (index ky = Y.tstart[jy]; ky < Y.tstart[jy + 1]; ++ky) {
-          const T w = T(Z.tw[kz] * Y.tw[ky]);
-          const T* rr = fine + a * Nf + fnx * (Y.tf[ky] + fny * Z.tf[kz]);
+    }
+    for (index q0 = 0; q0 < rows; q0 += 4) {
+      const T* r[4];
+      T w[4];
+      for (index u = 0; u < 4; ++u) {
+        const index q = q0 + u < rows ? q0 + u : q0, ky = y0 + q % ny, kz = z0 + q / ny;
+        r[u] = fine + a * Nf + fnx * (Y.tf[ky] + fny * Z.tf[kz]);
+        w[u] = q0 + u < rows ? T(Z.tw[kz] * Y.tw[ky]) : T(0);
+      }
+      const T *r0 = r[0], *r1 = r[1], *r2 = r[2], *r3 = r[3];
+      const T w0 = w[0], w1 = w[1], w2 = w[2], w3 = w[3];
+      if (q0 == 0) {
 #pragma omp simd
-          for (index i = 0; i < fnx; ++i) acc[i] += w * rr[i];
-        }
-      T* out = coarse + a * Nc + cnx * (jy + cny * jz);
-      TRESCA_DEVICE_LANES
-      for (index jx = 0; jx < cnx; ++jx) {
-        T sx = 0;
-        for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += T(X.tw[kx]) * acc[X.tf[kx]];
-        out[jx] = m.at(jx) ? T(0) : sx;
+        for (index i = 0; i < fnx; ++i) acc[i] = w0 * r0[i] + w1 * r1[i] + w2 * r2[i] + w3 * r3[i];
+      } else {
+#pragma omp simd
+        for (index i = 0; i < fnx; ++i) acc[i] += w0 * r0[i] + w1 * r1[i] + w2 * r2[i] + w3 * r3[i];
       }
     }
+    const ConstrainedRow m(c, zero_faces, jy, jz);
+    T* out = coarse + a * Nc + cnx * (jy + cny * jz);
+    if (X.halving) {
+#pragma omp simd
+      for (index j = 0; j < cnx; ++j) {
+        const index i = 2 * j;
+        const T w0 = T(X.pw[i]), w1 = T(X.pw[i + 1]), h0 = T(X.pw[i - 2]), h1 = T(X.pw[i - 1]);
+        const T sx = (1 - w0) * acc[i] + (1 - w1) * acc[i + 1] + h0 * acc[i - 2] + h1 * acc[i - 1];
+        out[j] = m.at(j) ? T(0) : sx;
+      }
+      return;
+    }
+    TRESCA_DEVICE_LANES
+    for (index jx = 0; jx < cnx; ++jx) {
+      T sx = 0;
+      for (index kx = X.tstart[jx]; kx < X.tstart[jx + 1]; ++kx) sx += T(X.tw[kx]) * acc[X.tf[kx]];
+      out[jx] = m.at(jx) ? T(0) : sx;
+    }
   };
-  for_each_block_with_scratch<T>(precision_name<T>("restriction", "restriction (float)"), c.nz(), c.ny(), fnx,
-                                 double(comps) * double(Nf) * in_precision<T>(kRestrictCost), coarse_row);
+  for_each_block_with_scratch<T>(precision_name<T>("restriction", "restriction (float)"), comps, c.nz(), c.ny(),
+                                 fnx + 4, double(comps) * double(Nf) * in_precision<T>(kRestrictCost), coarse_row);
 }
 
 template void restrict_to_coarse<double>(const Transfer&, int, const double*, double*, unsigned);

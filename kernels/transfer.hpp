@@ -8,10 +8,13 @@
 // at most two nonzeros. The optimised kernels are gathers (race-free, OpenMP
 // over output rows): prolongation combines, per fine row, the 4 coarse rows
 // of its y/z support into a coarse-length row buffer (vectorised) and then
-// interpolates along x from it; restriction sums, per coarse row, the weighted fine rows of its y/z support
-// into a row buffer (vectorised) and then gathers along x with the 1D
-// transposed lists. The _ref twins are the literal serial loops (restriction
-// as a scatter of P^T).
+// interpolates along x from it; restriction sums, per coarse row, the
+// weighted fine rows of its y/z support into a row buffer (vectorised, four
+// rows a pass) and then gathers along x. Along x, where the axis halves (the
+// multigrid's transfers), two fine nodes share one coarse interval: a lane
+// per pair of fine nodes, contiguous reads; elsewhere (a mesh of another
+// level's) the 1D lists, read indirectly. The _ref twins are the literal
+// serial loops (restriction as a scatter of P^T).
 //
 // DATA LAYOUT: SoA fields as in grid.hpp; `comps` components of size N each.
 // Cost per fine dof: prolongation 8 reads + 1 write; restriction about the same
@@ -38,12 +41,21 @@ struct Interp1D {
   // transpose lists: coarse j receives from fine tf[tstart[j]..tstart[j+1]) with weights tw
   Field<index> tstart, tf;
   Field<real> tw;
+  // Where the axis halves (j0[i] = i/2 for every fine node, the last one
+  // allowed as coarse node i/2 with weight 0 instead: every multigrid
+  // transfer, coarse e = ceil(fine e / 2), nested or not), pair_w[i + 2] is
+  // fine node i's weight of coarse node i/2 + 1, for i in [-2, 2 nc), 0
+  // outside the fine nodes: the kernels then run along x two fine nodes to a
+  // lane on contiguous reads, not one indirect read per node.
+  bool halving = false;
+  Field<real> pair_w;
   void move_to(Space s) {
     j0.move_to(s);
     w.move_to(s);
     tstart.move_to(s);
     tf.move_to(s);
     tw.move_to(s);
+    pair_w.move_to(s);
   }
 };
 

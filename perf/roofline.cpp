@@ -159,6 +159,12 @@ int main(int argc, char** argv) {
         [&] { bottom_block_apply(g, B.data(), x.data(), operator_out(y.data())); });
     add("restriction", dofs, dofs * kRestrictCost, [&] { restrict_to_coarse(t, 3, x.data(), xc.data()); });
     add("prolongation (+=)", dofs, dofs * kProlongateCost, [&] { prolongate(t, 3, xc.data(), y.data(), y.data()); });
+    // the V-cycle's transfers are in its precision (float by default)
+    Field<float> xcf(3 * c.nodes(), 0.5f), ypf(n, 0.0f);
+    add("restriction (float)", dofs, dofs * in_precision<float>(kRestrictCost),
+        [&] { restrict_to_coarse<float>(t, 3, xf.data(), xcf.data()); }, true);
+    add("prolongation (float)", dofs, dofs * in_precision<float>(kProlongateCost),
+        [&] { prolongate<float>(t, 3, xcf.data(), ypf.data(), ypf.data()); }, true);
     real sink = 0;
     add("dot", dofs, dofs * kDotCost, [&] { sink += 1e-300 * dot(n, x.data(), b.data()); });
     add("axpy", dofs, dofs * kAxpyCost, [&] { axpy(n, 1e-9, x.data(), y.data()); });

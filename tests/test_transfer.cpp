@@ -12,8 +12,25 @@ using test::max_abs_diff;
 using test::random_vector;
 
 namespace {
-const index kPairs[][6] = {{23, 12, 12, 12, 6, 6}, {7, 3, 5, 4, 2, 3}, {8, 4, 4, 4, 2, 2}, {5, 1, 2, 3, 1, 1}};
+// fine and coarse prisms (elements per axis): the multigrid's halvings,
+// nested and not (coarse e = ceil(fine e / 2)), and a mesh of another
+// level's (12 -> 9: the general axis, as in the nested iteration)
+const index kPairs[][6] = {
+    {23, 12, 12, 12, 6, 6}, {7, 3, 5, 4, 2, 3}, {8, 4, 4, 4, 2, 2}, {5, 1, 2, 3, 1, 1}, {12, 6, 7, 9, 4, 5}};
 }  // namespace
+
+// The kernels take the pairwise path along x wherever the axis halves: on
+// every multigrid transfer (coarse e = ceil(fine e / 2)) and on no other
+TEST(Transfer, EveryHalvingAxisIsRunInPairs) {
+  for (index e = 1; e <= 700; ++e) {
+    const Transfer t = build_transfer(test::prism(e, 1, 1), test::prism((e + 1) / 2, 1, 1));
+    EXPECT_TRUE(t.axis[0].halving) << e;
+    EXPECT_EQ(index(t.axis[0].pair_w.size()), 2 * ((e + 1) / 2 + 1) + 2);
+  }
+  EXPECT_FALSE(build_transfer(test::prism(12, 1, 1), test::prism(9, 1, 1)).axis[0].halving);
+  EXPECT_FALSE(build_transfer(test::prism(8, 1, 1), test::prism(3, 1, 1)).axis[0].halving);
+  EXPECT_FALSE(build_transfer(test::prism(8, 1, 1), test::prism(8, 1, 1)).axis[0].halving);
+}
 
 TEST(Transfer, OptimisedEqualsReferenceOnNonNestedGrids) {
   for (auto& p : kPairs) {
