@@ -1,6 +1,7 @@
 #include "transfer.hpp"
 
 #include <algorithm>
+#include <type_traits>
 
 #include "launch.hpp"
 
@@ -138,17 +139,24 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, const T*
     const T* v0 = base ? base + at : nullptr;
     if (X.halving) {
       // the pairs, then a last node of its own where fnx is odd (a nested
-      // axis's last fine node: weight 0 on s[cnx])
+      // axis's last fine node: weight 0 on s[cnx]); the base's test out of
+      // the loop (a load under a condition keeps it from the vector units)
       s[cnx] = 0;
+      const auto pairs = [&](auto with_base) {
 #pragma omp simd
-      for (index k = 0; k < fnx / 2; ++k) {
-        const index i = 2 * k;
-        const T a0 = s[k], a1 = s[k + 1], w0 = T(X.pw[i]), w1 = T(X.pw[i + 1]);
-        const T p0 = (v0 ? v0[i] : T(0)) + (1 - w0) * a0 + w0 * a1;
-        const T p1 = (v0 ? v0[i + 1] : T(0)) + (1 - w1) * a0 + w1 * a1;
-        v[i] = m.at(i) ? T(0) : p0;
-        v[i + 1] = m.at(i + 1) ? T(0) : p1;
-      }
+        for (index k = 0; k < fnx / 2; ++k) {
+          const index i = 2 * k;
+          const T a0 = s[k], a1 = s[k + 1], w0 = T(X.pw[i]), w1 = T(X.pw[i + 1]);
+          const T p0 = (with_base ? v0[i] : T(0)) + (1 - w0) * a0 + w0 * a1;
+          const T p1 = (with_base ? v0[i + 1] : T(0)) + (1 - w1) * a0 + w1 * a1;
+          v[i] = m.at(i) ? T(0) : p0;
+          v[i + 1] = m.at(i + 1) ? T(0) : p1;
+        }
+      };
+      if (v0)
+        pairs(std::true_type());
+      else
+        pairs(std::false_type());
       if (fnx % 2) {
         const index i = fnx - 1, k = i / 2;
         const T wx = T(X.pw[i]);
