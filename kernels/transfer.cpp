@@ -205,7 +205,7 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse, 
   TRESCA_ASSERT(comps >= 1 && comps <= 3 && index(t.axis[0].tstart.size()) == t.coarse.nx() + 1);
   // Per coarse row (jy, jz): sum the weighted fine rows of its y/z support
   // (4 to 16 of them) into one row buffer, four rows a pass (contiguous,
-  // vectorised; one pass a row took 30 % longer), then gather along x:
+  // vectorised; a pass a row took 1.5 times as long), then gather along x:
   // along a halving axis coarse node j takes fine pair j's share of its
   // first coarse node and pair j-1's of its second (a lane per coarse node,
   // contiguous reads; the buffer has two zero entries each side), along
