@@ -143,7 +143,7 @@ void prolongate(const Transfer& t, int comps, const T* coarse, T* fine, const T*
       // the loop (a load under a condition keeps it from the vector units)
       s[cnx] = 0;
       const auto pairs = [&](auto with_base) {
-#pragma omp simd
+#pragma omp simd  // vector loop (tests/check_vectorised.py)
         for (index k = 0; k < fnx / 2; ++k) {
           const index i = 2 * k;
           const T a0 = s[k], a1 = s[k + 1], w0 = T(X.pw[i]), w1 = T(X.pw[i + 1]);
@@ -239,17 +239,17 @@ void restrict_to_coarse(const Transfer& t, int comps, const T* fine, T* coarse, 
       const T *r0 = r[0], *r1 = r[1], *r2 = r[2], *r3 = r[3];
       const T w0 = w[0], w1 = w[1], w2 = w[2], w3 = w[3];
       if (q0 == 0) {
-#pragma omp simd
+#pragma omp simd  // vector loop (tests/check_vectorised.py)
         for (index i = 0; i < fnx; ++i) acc[i] = w0 * r0[i] + w1 * r1[i] + w2 * r2[i] + w3 * r3[i];
       } else {
-#pragma omp simd
+#pragma omp simd  // vector loop (tests/check_vectorised.py)
         for (index i = 0; i < fnx; ++i) acc[i] += w0 * r0[i] + w1 * r1[i] + w2 * r2[i] + w3 * r3[i];
       }
     }
     const ConstrainedRow m(c, zero_faces, jy, jz);
     T* out = coarse + a * Nc + cnx * (jy + cny * jz);
     if (X.halving) {
-#pragma omp simd
+#pragma omp simd  // vector loop (tests/check_vectorised.py)
       for (index j = 0; j < cnx; ++j) {
         const index i = 2 * j;
         const T w0 = T(X.pw[i]), w1 = T(X.pw[i + 1]), h0 = T(X.pw[i - 2]), h1 = T(X.pw[i - 1]);
