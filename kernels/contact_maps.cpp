@@ -65,6 +65,7 @@ ResidualNorms approximation_step(index p, const ContactLaw& law, const real* sca
   // in tests/test_newton.cpp, ApproximationStep; the dense reference Newton
   // there.)
   auto sweep = [&](auto has_units, auto has_scale) {
+    // vector loop (tests/check_vectorised.py)
     for_each_entry("approximation step", p, kApproximationStepCost, [=](index i) {
       // x3 enters through F_4 = u_z + g
       const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + law.gap[i], x4 = lambda[i];

@@ -2,14 +2,15 @@
 """Cliff guard at compile time: the loops of SOURCE marked as vector loops
 must be vectorised by the build's compiler with the build's own flags.
 
-    check_vectorised.py COMPILE_COMMANDS SOURCE
+    check_vectorised.py COMPILE_COMMANDS SOURCE [SOURCE ...]
 
-A loop is marked by its `#pragma omp simd` line ending in the comment
-`// vector loop (tests/check_vectorised.py)`. For every compile of SOURCE in
+A loop is marked by the comment `// vector loop (tests/check_vectorised.py)`
+at the end of its `#pragma omp simd` line, or on a line of its own before
+a loop or a launch of a body (for_each_entry). For every compile of SOURCE in
 COMPILE_COMMANDS (CMake's compile_commands.json: the main build's and the
 portable one's), the script runs that compile again into /dev/null with
 GCC's `-fopt-info-vec-optimized` and requires a "loop vectorized" report on
-the `for` that follows each mark. A loop that GCC keeps out of
+the loop that follows each mark. A loop that GCC keeps out of
 the vector units does not fail a test by its answers, and a timed ratio
 cannot tell it on every machine (the transfers' pair sweeps, scalar, still
 beat their index lists by 1.15-1.55x): this reads the compiler's own word.
@@ -25,22 +26,24 @@ MARK = "// vector loop (tests/check_vectorised.py)"
 
 
 def marked_loops(source):
+    """For each mark, the lines where GCC may report its loop."""
     lines = open(source).read().splitlines()
     loops = []
     for n, line in enumerate(lines):
         if MARK not in line:
             continue
-        if "#pragma omp simd" not in line:
-            sys.exit(f"{source}:{n + 1}: the mark belongs on a `#pragma omp simd` line")
-        following = [k for k in range(n + 1, min(n + 4, len(lines))) if re.match(r"\s*for \(", lines[k])]
-        if not following:
-            sys.exit(f"{source}:{n + 1}: no `for` after the marked pragma")
+        # a mark on a line of its own is for the line after it
+        start = n + 1 if line.strip().startswith("//") else n
+        if start < len(lines) and "#pragma omp simd" in lines[start]:
+            following = [k for k in range(start + 1, min(start + 4, len(lines))) if re.match(r"\s*for \(", lines[k])]
+            if not following:
+                sys.exit(f"{source}:{n + 1}: no `for` after the marked pragma")
+            start = following[0]
         # GCC reports a loop at its `for` or at one of the statements just
-        # after it (a loop in a lambda): the `for` line and the next two,
-        # up to the next pragma
-        first = following[0]
-        window = [first + 1]
-        for k in range(first + 1, min(first + 3, len(lines))):
+        # after it (a loop in a lambda; a launch's loop at its body's first
+        # statement): the loop's line and the next two, up to a pragma
+        window = [start + 1]
+        for k in range(start + 1, min(start + 3, len(lines))):
             if "#pragma" in lines[k]:
                 break
             window.append(k + 1)
@@ -68,16 +71,14 @@ def rerun(entry):
     return run.stderr, out
 
 
-def main():
-    if len(sys.argv) != 3:
-        sys.exit(__doc__)
-    db, source = sys.argv[1], os.path.realpath(sys.argv[2])
+def check(db, source):
+    source = os.path.realpath(source)
     loops = marked_loops(source)
     if not loops:
         sys.exit(f"{source}: no marked loop")
-    entries = [e for e in json.load(open(db)) if os.path.realpath(os.path.join(e["directory"], e["file"])) == source]
+    entries = [e for e in db if os.path.realpath(os.path.join(e["directory"], e["file"])) == source]
     if not entries:
-        sys.exit(f"{db}: no compile of {source}")
+        sys.exit(f"no compile of {source} in the compile commands")
     name = os.path.basename(source)
     failed = False
     for e in entries:
@@ -88,7 +89,15 @@ def main():
             ok = any(line in done for line in window)
             failed |= not ok
             print(f"{name}:{window[0]} {march}: {'vectorised' if ok else 'NOT vectorised'}")
-    return 1 if failed else 0
+    return failed
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit(__doc__)
+    db = json.load(open(sys.argv[1]))
+    failed = [check(db, source) for source in sys.argv[2:]]
+    return 1 if any(failed) else 0
 
 
 if __name__ == "__main__":
