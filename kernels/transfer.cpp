@@ -37,15 +37,15 @@ Interp1D build_axis(index ef, index ec) {
     }
     a.tstart.push_back(index(a.tf.size()));
   }
-  a.halving = nf >= 2 * nc - 2;
+  bool halving = nf >= 2 * nc - 2;
   a.pair_w.resize(2 * nc + 2);
-  for (index i = 0; i < nf && a.halving; ++i) {
+  for (index i = 0; i < nf && halving; ++i) {
     if (a.j0[i] == i / 2)
       a.pair_w[i + 2] = a.w[i];
     else  // (the last node as coarse node i/2, if that is its only one)
-      a.halving = i == nf - 1 && a.j0[i] == i / 2 - 1 && a.w[i] == 1;
+      halving = i == nf - 1 && a.j0[i] == i / 2 - 1 && a.w[i] == 1;
   }
-  if (!a.halving) a.pair_w = Field<real>();
+  if (!halving) a.pair_w = Field<real>();
   return a;
 }
 
@@ -60,8 +60,8 @@ struct AxisView {
         tf(a.tf.data()),
         w(a.w.data()),
         tw(a.tw.data()),
-        pw(a.halving ? a.pair_w.data() + 2 : nullptr),
-        halving(a.halving) {}
+        pw(a.halving() ? a.pair_w.data() + 2 : nullptr),
+        halving(a.halving()) {}
 };
 
 }  // namespace

@@ -46,9 +46,10 @@ struct Interp1D {
   // transfer, coarse e = ceil(fine e / 2), nested or not), pair_w[i + 2] is
   // fine node i's weight of coarse node i/2 + 1, for i in [-2, 2 nc), 0
   // outside the fine nodes: the kernels then run along x two fine nodes to a
-  // lane on contiguous reads, not one indirect read per node.
-  bool halving = false;
+  // lane on contiguous reads, not one indirect read per node. Empty where
+  // the axis does not halve.
   Field<real> pair_w;
+  bool halving() const { return pair_w.size() > 0; }
   void move_to(Space s) {
     j0.move_to(s);
     w.move_to(s);

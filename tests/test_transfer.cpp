@@ -24,12 +24,12 @@ const index kPairs[][6] = {
 TEST(Transfer, EveryHalvingAxisIsRunInPairs) {
   for (index e = 1; e <= 700; ++e) {
     const Transfer t = build_transfer(test::prism(e, 1, 1), test::prism((e + 1) / 2, 1, 1));
-    EXPECT_TRUE(t.axis[0].halving) << e;
+    EXPECT_TRUE(t.axis[0].halving()) << e;
     EXPECT_EQ(index(t.axis[0].pair_w.size()), 2 * ((e + 1) / 2 + 1) + 2);
   }
-  EXPECT_FALSE(build_transfer(test::prism(12, 1, 1), test::prism(9, 1, 1)).axis[0].halving);
-  EXPECT_FALSE(build_transfer(test::prism(8, 1, 1), test::prism(3, 1, 1)).axis[0].halving);
-  EXPECT_FALSE(build_transfer(test::prism(8, 1, 1), test::prism(8, 1, 1)).axis[0].halving);
+  EXPECT_FALSE(build_transfer(test::prism(12, 1, 1), test::prism(9, 1, 1)).axis[0].halving());
+  EXPECT_FALSE(build_transfer(test::prism(8, 1, 1), test::prism(3, 1, 1)).axis[0].halving());
+  EXPECT_FALSE(build_transfer(test::prism(8, 1, 1), test::prism(8, 1, 1)).axis[0].halving());
 }
 
 TEST(Transfer, OptimisedEqualsReferenceOnNonNestedGrids) {
