@@ -70,10 +70,13 @@ const char* to_string(Ran r) {
 void detail::count_launch(const char* kernel, Ran ran, Cost work, long long ns) {
   Census& c = census();
   const std::lock_guard<std::mutex> lock(c.mutex);
-  // a name is a string literal: the same pointer, or the same text where
-  // two translation units each hold a copy of it
-  auto s = std::find_if(c.slots.begin(), c.slots.end(),
-                        [&](const KernelSlot& k) { return k.kernel == kernel || !std::strcmp(k.kernel, kernel); });
+  // a name is a string literal: the same pointer (every slot compared by
+  // pointer first, no string compare on a launch's usual path), or the same
+  // text where two translation units each hold a copy of it
+  auto s = std::find_if(c.slots.begin(), c.slots.end(), [&](const KernelSlot& k) { return k.kernel == kernel; });
+  if (s == c.slots.end())
+    s = std::find_if(c.slots.begin(), c.slots.end(),
+                     [&](const KernelSlot& k) { return !std::strcmp(k.kernel, kernel); });
   if (s == c.slots.end()) s = c.slots.insert(c.slots.end(), KernelSlot{kernel});
   const int r = int(ran);
   s->calls[r] += 1;
