@@ -531,7 +531,7 @@ bool NewtonSolve::measure(int k) {
         const real F = opt.friction.F;
         const real* d4 = x.d.data() + 2 * p;
         real* phi = x.phi.data();
-        for_each_entry("coulomb bound", p, Cost{16, 1}, [=](index i) { phi[i] = F * d4[i]; });
+        for_each_entry("coulomb bound of d4", p, Cost{16, 1}, [=](index i) { phi[i] = F * d4[i]; });
         approximation_step(p, ContactLaw{phi, gap.data(), opt.kink_contact}, scale_ptr, units.data(), x.u.data(),
                            x.lambda.data(), x.r.data(), trial.v.data(), trial.w.data(), x.d.data(), x.status.data());
       }
