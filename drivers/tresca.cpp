@@ -457,6 +457,9 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
               N.outer_iterations, N.operator_applications);
   if (N.outer_limit_hits > 0)
     std::printf("note: %d Newton steps were taken with an outer CG stopped at its iteration limit\n", N.outer_limit_hits);
+  if (N.watchdog_steps > 0)
+    std::printf("note: %d Newton steps were taken whole where no step length decreased |w| (the line search's watchdog)\n",
+                N.watchdog_steps);
   char device_peak[64] = "";
   if (R.peak_device_memory > 0)
     std::snprintf(device_peak, sizeof device_peak, ", device Fields at most %.2f GB", R.peak_device_memory / 1e9);

@@ -282,6 +282,16 @@ TEST(TrescaDriver, WarnsWhenItsCoresAreBusy) {
   EXPECT_EQ(p.out.find("another process"), std::string::npos) << p.out;
 }
 
+TEST(TrescaDriver, ConvergesOverAMicrometreGapAndSaysHow) {
+  // before: "not converged (stagnation)" at the first step for gaps below
+  // about 1e-4 m (semismooth.hpp: the line search's watchdog); a nested run
+  // takes that step on its coarsest mesh, whose note the fine mesh's
+  // report does not repeat
+  expect_run("tresca --dims 16x8x8 --gap 1e-6 --no-nested --quiet", 0,
+             "note: 1 Newton steps were taken whole where no step length decreased |w|");
+  expect_run("tresca --level 6 --gap 1e-6 --quiet", 0, "max uz -1.000000e-06");
+}
+
 TEST(TrescaDriver, NearlyIncompressibleMaterialFailsFastAndSaysWhy) {
   // Q1 locks at nu -> 0.5 and the multigrid CGs cannot converge: the run
   // must stop with the reason, not hang (the loose first residual passes;

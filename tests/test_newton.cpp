@@ -372,6 +372,43 @@ TEST(SemismoothNewton, MatchesDenseReferenceWithAGap) {
   compare_with_dense({}, 8, 4, 4, [](index i) { return uniform(1e7, i); }, true, false, 0.05);
 }
 
+TEST(SemismoothNewton, TakesTheFallThroughASmallGapWholeAndReachesTheDenseSolution) {
+  // the benchmark (phi = 1) on 16x8x8 with the plane 1 micrometre below
+  // the face: from x0 = 0 every node is separated, and the first step falls
+  // freely through the plane by centimetres, which raises |w| by the
+  // penetration times the stiffness for every step length down to 2^-10;
+  // the watchdog takes it whole and the next step puts the nodes on the
+  // plane, as the dense reference's full steps do (before: stagnation at
+  // the first step, for gaps from 1e-20 to about 1e-4 m; on 8x4x4 and
+  // 12x6x6 a halved first step still decreased |w|)
+  const real gap = 1e-6;
+  ProblemSpec spec = spec_for_dims(16, 8, 8);
+  spec.obstacle.gap = gap;
+  RunOptions o;
+  o.recover_interior = false;
+  o.nested = false;
+  const RunResult R = run_tresca(spec, o);
+  ASSERT_TRUE(R.converged()) << R.reason();
+  EXPECT_EQ(R.newton.watchdog_steps, 1);
+  EXPECT_EQ(R.newton.step_lengths.front(), 1.0);
+  EXPECT_GT(R.newton.merit[1], 10 * R.newton.merit[0]);  // the step no length of which decreased |w|
+  EXPECT_LE(R.newton.iterations, 5);
+  const index p = R.problem->contact_nodes();
+  EXPECT_EQ(R.report.active, p);  // every node on the plane, none below it
+  EXPECT_LT(R.report.uz_violation, 1e-12);
+  // the dense reference (full steps, exact solves) reaches the same solution
+  const DenseSchur D = dense_schur(*R.problem);
+  SteklovPoincare S(*R.problem);
+  const std::vector<real> s = step_scale(S);
+  const DenseNewton ref = dense_newton(D.S, D.b, R.contact.phi, gap, s, 1e-6, 60, -1, s);
+  ASSERT_LE(ref.history.back(), 1e-6) << "dense reference did not converge";
+  real umax, lmax;
+  const auto e = iterate_errors(R.newton.u, R.newton.lambda, ref.x, umax, lmax);
+  EXPECT_LT(e.first, 1e-8 * umax);
+  EXPECT_LT(e.second, 1e-8 * lmax);
+  for (index i = 0; i < p; ++i) EXPECT_NEAR(R.newton.u[2 * p + i], -gap, 1e-9 * gap) << i;
+}
+
 TEST(SemismoothNewton, MatchesDenseReferenceWhereThePaperStepLosesThePath) {
   // 12x6x6, phi = 1e6: the paper's exact-step method takes 7 steps; its
   // inexact matrix-free twin parted from it at step 4 and took 9 (issue 9)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -416,6 +417,7 @@ class NewtonSolve {
   CGWorkspace ws;
   real smax = 0;  // |S x| <= smax |x|
   bool last_step_hit_limit = false;
+  int last_watchdog = std::numeric_limits<int>::min() / 2;  // the last step the watchdog took whole
   real eta;
   // this iteration's |v̂|, merit |w| and tolerance
   real vnorm = 0, merit = 0, tol = 0;
@@ -629,7 +631,15 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
       ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
       return std::sqrt(S.sum(residual_at(trial).consistent));
     });
-    if (alpha == 0) return NewtonReason::stagnation;
+    if (alpha == 0) {
+      // the watchdog (NewtonOptions::line_search): a step solved to its
+      // tolerance is taken whole, once in line_search_memory + 1 steps
+      const int k = int(R.step_lengths.size());
+      if (last_step_hit_limit || k - last_watchdog <= opt.line_search_memory) return NewtonReason::stagnation;
+      last_watchdog = k;
+      R.watchdog_steps += 1;
+      alpha = 1;
+    }
   }
   R.step_lengths.push_back(alpha);
   axpy(p, alpha, dlambda.data(), x.lambda.data());

@@ -118,12 +118,19 @@ struct NewtonOptions {
   // (semismooth Newton wanders while the active set settles) but the
   // window's maximum falls. Trial points cost no solve: r, lambda and the
   // body are linear along the step, whose S Δu the update computes anyway.
-  // Stagnation, evidence that Newton is not converging: no length down to
-  // 2^-line_search_halvings decreases the merit, or the best merit of the
-  // last stagnation_window steps is not below half the best before them
-  // (the round-off floor of an unattainable eps, where the non-monotone
-  // search would let the iterates wander). Off: full steps, and only the
-  // second test.
+  // Where no length down to 2^-line_search_halvings decreases the merit, a
+  // step whose boundary system was solved to its tolerance is taken whole
+  // all the same, once in line_search_memory + 1 steps (a watchdog): a
+  // change of the active set can raise |w| for one step that the next
+  // brings down, e.g. a cold start over a gap, whose first step falls
+  // freely through the obstacle (|w| of the penetration: s times metres)
+  // and whose second puts the nodes on it (NewtonResult::watchdog_steps).
+  // Stagnation, evidence that Newton is not converging: no length decreases
+  // the merit and the watchdog may not step, or the best merit of the last
+  // stagnation_window steps is not below half the best before them (the
+  // round-off floor of an unattainable eps, where the non-monotone search
+  // would let the iterates wander). Off: full steps, and only the second
+  // test.
   bool line_search = true;
   bool kink_contact = true;  // contact_maps.hpp: ContactLaw::kink_contact
   int line_search_memory = 5;
@@ -189,6 +196,7 @@ struct NewtonResult {
   bool kink_contact = true;            // the options' kink rule (the status above)
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
   int outer_limit_hits = 0;  // Newton steps whose outer CG stopped at its iteration limit
+  int watchdog_steps = 0;    // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
   // work in fine-grid matvec equivalents, from the solvers' own counts and
   // cost models (SteklovPoincare::apply_work, BoundaryPreconditioner::apply_work)
   double fine_matvecs = 0;
