@@ -16,7 +16,12 @@ constexpr real kPenalty = 1e4;
 BoundaryPreconditioner::BoundaryPreconditioner(const SteklovPoincare& S, const MGOptions& mg)
     : S_(S), kdiag_(S.contact_diagonal()) {
   const Problem& P = S.problem();
-  // the K_ii solver's grids, transfers and smoother bounds
+  // the K_ii solver's grids, transfers and smoother bounds: those were
+  // estimated on K with the contact face free (steklov.cpp), and they bound
+  // D^-1 (K + B) for every B of update() below: B's penalties are diagonal
+  // and its 2x2 blocks H at most twice their diagonal, under the bounds'
+  // floor 2.3 (smoothing.hpp), so the Rayleigh quotient of K + B over its
+  // diagonal is at most the larger of K's and 2
   mg_ = std::make_unique<Multigrid>(S.interior_multigrid().hierarchy(),
                                     elasticity_on(P.dirichlet_faces, P.spec.E, P.spec.nu), mg, &S.interior_multigrid());
 }

@@ -14,7 +14,8 @@
 // a tenth of one S application.
 //
 // The V-cycle runs on the K_ii solver's hierarchy (grids, transfers, row
-// fetches, smoother bounds), shared. Several ranks: each rank fills B at
+// fetches, smoother bounds, which were estimated to hold for K + B too:
+// boundary_preconditioner.cpp), shared. Several ranks: each rank fills B at
 // its contact nodes and one allreduce of the plane (4 nx ny values per
 // Newton step) gives every rank the whole of it.
 #pragma once

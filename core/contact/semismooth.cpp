@@ -579,7 +579,7 @@ std::optional<NewtonReason> NewtonSolve::newton_step() {
   R.operator_applications += step.outer.iterations + (step.known_applied ? 1 : 0);
   if (step.inner_failed) return NewtonReason::inner_failure;
   if (step.outer.reason == SolveReason::non_finite) return NewtonReason::non_finite;
-  if (step.outer.reason == SolveReason::breakdown) return NewtonReason::inner_failure;
+  if (step.outer.reason == SolveReason::breakdown) return NewtonReason::outer_failure;
   const bool limit = step.outer.reason == SolveReason::max_iterations;
   if (limit) R.outer_limit_hits += 1;  // inexact step taken
   if (limit && last_step_hit_limit) return NewtonReason::outer_failure;

@@ -56,7 +56,10 @@ namespace tresca {
 
 // outer_failure: two Newton steps in a row whose boundary CG stopped at its
 // iteration limit (the step systems are not being solved: e.g. nearly
-// incompressible material, where it used to grind on for minutes)
+// incompressible material, where it used to grind on for minutes), or a
+// boundary Krylov solve that broke down (a direction of zero or negative
+// curvature: the step's operator or its preconditioner not positive);
+// inner_failure: a K_ii solve of an application of S failed
 enum class NewtonReason { converged, iteration_limit, stagnation, inner_failure, non_finite, outer_failure };
 const char* to_string(NewtonReason r);
 

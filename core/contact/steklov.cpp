@@ -12,7 +12,10 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
     : P_(P), p_(P.contact_nodes()), comm_(split_over(P.grid, comm)), mg_opt_(mg) {
   const auto grids = GridHierarchy::build(P.grid, mg.coarse_nodes, comm_);
   K_ = ElasticityOperator(grids->levels[0].slab, P.dirichlet_faces, P.spec.E, P.spec.nu);
-  mg_ = std::make_unique<Multigrid>(grids, elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mg);
+  // (its smoother's bounds from K with the contact face free: they hold
+  // for the Newton step's K + B too, which shares them)
+  mg_ = std::make_unique<Multigrid>(grids, elasticity_on(P.interior_faces, P.spec.E, P.spec.nu), mg, nullptr,
+                                    elasticity_on(P.dirichlet_faces, P.spec.E, P.spec.nu));
   // contact node c = (ix - 1) + ex iy: a rank's rows hold a contiguous range
   const index ex = P.grid.ex;
   c_begin_ = ex * slab().y_begin;

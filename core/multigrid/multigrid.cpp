@@ -35,6 +35,15 @@ GridDims coarsen(const GridDims& g) {
   return c;
 }
 
+// 1 / diag(A) in precision T where the launches run (0 on ghost rows)
+template <class T>
+Field<T> inverse_diagonal(const ElasticityOperator& A) {
+  const Field<real> d = A.diagonal();
+  Field<T> dinv(d.size());
+  reciprocal_or_zero<T>(index(d.size()), d.data(), dinv.data());
+  return dinv;
+}
+
 // local rows [first, last) of slab s as global rows
 void row_range(const Slab& s, index& first, index& last) {
   first = s.y_begin - s.lo;
@@ -174,7 +183,7 @@ Multigrid::Multigrid(const GridDims& fine, unsigned faces, real E, real nu, cons
     : Multigrid(GridHierarchy::build(fine, opt.coarse_nodes, comm), elasticity_on(faces, E, nu), opt) {}
 
 Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt,
-                     const Multigrid* like)
+                     const Multigrid* like, const Rediscretisation& bounds_of)
     : opt_(opt), grids_(std::move(grids)) {
   if (!grids_ || grids_->levels.empty()) throw std::invalid_argument("multigrid: empty grid hierarchy");
   if (like && like->grids_ != grids_)
@@ -195,14 +204,24 @@ Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscret
     build_work<float>(like);
   else
     build_work<double>(like);
-  for (int l = 0; l + 1 < num_levels(); ++l) {
-    if (like)
-      levels_[l].lmax = like->levels_[l].lmax;
-    else if (single)
-      estimate_lmax<float>(l);
-    else
-      estimate_lmax<double>(l);
-  }
+  auto estimate = [&](auto zero) {
+    using T = decltype(zero);
+    for (int l = 0; l + 1 < num_levels(); ++l) {
+      if (like) {
+        levels_[l].lmax = like->levels_[l].lmax;
+      } else if (bounds_of) {
+        const HostLaunches where(on_host(std::size_t(l)));
+        const ElasticityOperator A = bounds_of(grids_->levels[l].slab);
+        levels_[l].lmax = estimate_lmax<T>(l, A, inverse_diagonal<T>(A));
+      } else {
+        levels_[l].lmax = estimate_lmax<T>(l, levels_[l].A, held<T>().dinv[std::size_t(l)]);
+      }
+    }
+  };
+  if (single)
+    estimate(float{});
+  else
+    estimate(double{});
   factor_coarse();
 }
 
@@ -252,18 +271,15 @@ void Multigrid::refresh_work() {
   D.resize(levels_.size());
   for (size_t l = 0; l < levels_.size(); ++l) {
     const HostLaunches where(on_host(l));
-    const Field<real> d = levels_[l].A.diagonal();
-    D[l].resize(d.size());
-    reciprocal_or_zero<T>(index(d.size()), d.data(), D[l].data());  // ghost rows: 0
+    D[l] = inverse_diagonal<T>(levels_[l].A);
   }
 }
 
 template <class T>
-void Multigrid::estimate_lmax(int l) {
+real Multigrid::estimate_lmax(int l, const ElasticityOperator& A, const Field<T>& dinv) const {
   const HostLaunches where(on_host(std::size_t(l)));
-  Level& lv = levels_[l];
   const GridHierarchy::Level& h = grids_->levels[l];
-  const index n = lv.A.size();
+  const index n = A.size();
   // the start vector by global dof index: runs of nx entries (one node row,
   // each from its own jump of the generator), made on the host's threads and
   // moved where the launches run
@@ -283,16 +299,16 @@ void Multigrid::estimate_lmax(int l) {
     });
     r.move_to(host.space_before());
   }
-  zero_constrained(box, lv.A.faces(), r.data());
-  lv.A.zero_ghosts(r.data());
-  // in the smoother's precision, with its inverse diagonal (refresh_work)
-  lv.lmax = lanczos_lmax<T>(
+  zero_constrained(box, A.faces(), r.data());
+  A.zero_ghosts(r.data());
+  // in the smoother's precision
+  return lanczos_lmax<T>(
       n,
       [&](T* p, T* q) {
-        lv.A.update_ghosts(p);
-        lv.A.apply(p, q);
+        A.update_ghosts(p);
+        A.apply(p, q);
       },
-      held<T>().dinv[std::size_t(l)], std::move(r), h.distributed ? grids_->comm : nullptr);
+      dinv, std::move(r), h.distributed ? grids_->comm : nullptr);
 }
 
 void Multigrid::factor_coarse() {

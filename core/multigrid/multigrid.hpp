@@ -159,15 +159,22 @@ Rediscretisation elasticity_on(unsigned faces, real E, real nu);
 
 class Multigrid : public LinearOperator {
  public:
-  // like: take the smoother's spectral bounds from that multigrid (its
-  // hierarchy must be `grids`) instead of estimating them, for an operator
-  // whose Jacobi-scaled spectrum is the same up to boundary terms (the K + B
-  // preconditioner of the Newton step against the K_ii solver, well inside
-  // the smoother's safety margin; perf/RESULTS.md §0i), and share its
-  // V-cycle's work vectors (in the same precision): one V-cycle of either
-  // may not run inside the other's
+  // The smoother's spectral bounds (the largest eigenvalue of D^-1 A per
+  // level) are estimated on op, or
+  // - bounds_of: on that operator instead, one whose matrix holds op's as
+  //   a principal submatrix (op with more constrained faces: its Jacobi-
+  //   scaled spectrum lies below the larger one's, Cauchy interlacing), so
+  //   that a multigrid built `like` this one may share them (the K_ii
+  //   solver's, estimated on K with the contact face free, bound the K + B
+  //   of the Newton step's preconditioner: semismooth.hpp; on a mesh one
+  //   element thick, K_ii's own were a third too low for it and its CG
+  //   broke down, perf/RESULTS.md §0zd);
+  // - like: taken from that multigrid (its hierarchy must be `grids`),
+  //   whose bounds must hold for op, which also shares its V-cycle's work
+  //   vectors (in the same precision): one V-cycle of either may not run
+  //   inside the other's
   Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscretisation& op, const MGOptions& opt = {},
-            const Multigrid* like = nullptr);
+            const Multigrid* like = nullptr, const Rediscretisation& bounds_of = {});
   // builds its own hierarchy (opt.coarse_nodes) for elasticity on `fine`
   Multigrid(const GridDims& fine, unsigned faces, real E, real nu, const MGOptions& opt = {},
             const Comm& comm = Comm::self());
@@ -260,8 +267,11 @@ class Multigrid : public LinearOperator {
   T* prolongate_correction(int l) const;  // into the post-smoother's entry; returns it
   void check_launch_space() const;  // throws std::logic_error: built for one space, applied in the other
   void factor_coarse();
+  // the largest eigenvalue of D^-1 A of level l's operator A on its part
+  // of the grid (Lanczos in precision T, smoothing.hpp), A and D^-1 where
+  // level l runs
   template <class T>
-  void estimate_lmax(int l);  // after build_work<T>
+  real estimate_lmax(int l, const ElasticityOperator& A, const Field<T>& dinv) const;
   const Comm& comm() const { return *grids_->comm; }
 
   MGOptions opt_;
