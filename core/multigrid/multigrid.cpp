@@ -199,12 +199,11 @@ Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscret
       throw std::invalid_argument("multigrid: the rediscretised operator does not live on the hierarchy's grid");
     levels_.push_back(std::move(lv));
   }
-  const bool single = opt_.precision == Precision::single_precision;
-  if (single)
-    build_work<float>(like);
-  else
-    build_work<double>(like);
-  auto estimate = [&](auto zero) {
+  // the smoother's bounds, in the V-cycle's precision: borrowed, or
+  // estimated on bounds_of before this multigrid's work vectors exist (so
+  // the estimate's own vectors add nothing to the peak), or on op with the
+  // inverse diagonal of the work
+  auto setup = [&](auto zero) {
     using T = decltype(zero);
     for (int l = 0; l + 1 < num_levels(); ++l) {
       if (like) {
@@ -213,15 +212,17 @@ Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscret
         const HostLaunches where(on_host(std::size_t(l)));
         const ElasticityOperator A = bounds_of(grids_->levels[l].slab);
         levels_[l].lmax = estimate_lmax<T>(l, A, inverse_diagonal<T>(A));
-      } else {
-        levels_[l].lmax = estimate_lmax<T>(l, levels_[l].A, held<T>().dinv[std::size_t(l)]);
       }
     }
+    build_work<T>(like);
+    if (!like && !bounds_of)
+      for (int l = 0; l + 1 < num_levels(); ++l)
+        levels_[l].lmax = estimate_lmax<T>(l, levels_[l].A, held<T>().dinv[std::size_t(l)]);
   };
-  if (single)
-    estimate(float{});
+  if (opt_.precision == Precision::single_precision)
+    setup(float{});
   else
-    estimate(double{});
+    setup(double{});
   factor_coarse();
 }
 
