@@ -126,6 +126,13 @@ TEST(ProblemFile, ErrorsNameTheKey) {
   EXPECT_NE(error_of(R"({"obstacle": {"kind": "plane", "slope": [-0.1, 0]}})").find("cuts into the contact face"),
             std::string::npos);
   EXPECT_NE(error_of(R"({"mesh": {"level": 4},})").find("is not valid JSON"), std::string::npos);
+  // a key twice in one object: JSON keeps the last, which must not drop the first silently
+  EXPECT_NE(error_of(R"({"mesh": {"level": 4}, "mesh": {"level": 5}})").find("'mesh' is given twice"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"loads": {"traction": {"z1": [0, 0, 1], "z1": [0, 0, 2]}}})")
+                .find("'loads.traction.z1' is given twice"),
+            std::string::npos);
+  EXPECT_EQ(error_of(R"({"loads": {"traction": {"z1": [0, 0, 1]}, "body_force": [0, 0, 1]}, "box": {}})"), "");
   EXPECT_EQ(error_of(R"({"mesh": {"level": 4}})"), "");
   for (const std::string& e : {error_of(R"({"materail": {}})"), error_of("[1, 2]")}) {
     EXPECT_EQ(e.rfind("case.json: ", 0), 0u) << e;

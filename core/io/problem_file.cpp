@@ -60,11 +60,31 @@ class Reader {
 ProblemFile parse_problem(const std::string& text, const std::string& origin) {
   const Reader r(origin);
   json j;
+  // a key given twice in one object: JSON keeps the last, which would
+  // silently drop the first (the parser's callback sees each key as read)
+  std::vector<std::set<std::string>> keys;  // of the objects open now
+  std::vector<std::string> path;            // their keys
+  std::string twice;
+  const json::parser_callback_t note_keys = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) {
+      keys.emplace_back();
+    } else if (event == json::parse_event_t::object_end) {
+      keys.pop_back();
+    } else if (event == json::parse_event_t::key) {
+      const std::string k = parsed.get<std::string>();
+      path.resize(keys.size() - 1);
+      path.push_back(k);
+      if (!keys.back().insert(k).second && twice.empty())
+        for (const std::string& p : path) twice += (twice.empty() ? "" : ".") + p;
+    }
+    return true;
+  };
   try {
-    j = json::parse(text, nullptr, true, /*ignore_comments=*/true);
+    j = json::parse(text, note_keys, true, /*ignore_comments=*/true);
   } catch (const json::parse_error& e) {
     r.fail("", std::string("is not valid JSON: ") + e.what());
   }
+  if (!twice.empty()) r.fail(twice, "is given twice (JSON would keep the last silently)");
   // a run summary (tresca --json): its "problem" object, the rest ignored
   if (j.is_object() && j.contains("residual_history") && j.contains("problem") && j["problem"].is_object()) {
     const json inner = j["problem"];
