@@ -2,6 +2,7 @@
 // Newton method, matrix-free on the contact boundary. See --help.
 // Exit status: 0 converged, 1 not converged, 2 bad input, 3 output failure,
 // 4 out of memory.
+#include <algorithm>
 #include <cstdlib>
 #include <cmath>
 #include <cstdio>
@@ -299,6 +300,17 @@ void warn_about(const Command& c) {
                  "tresca: warning: nu = %g is nearly incompressible: Q1 elements lock and the multigrid inner solver "
                  "degrades (it may fail to converge)\n",
                  c.spec.nu);
+  // a sphere or cylinder placed off the face (a unit slip, a sign): the body
+  // then moves freely, a valid run that is rarely what was meant
+  const ProblemSpec& s = c.spec;
+  if (s.obstacle.kind != Obstacle::Kind::plane && c.opt.contact.gap.empty()) {
+    const std::vector<real> gap = contact_conditions(s).gap;
+    if (std::none_of(gap.begin(), gap.end(), [](real g) { return g < Obstacle::kNoObstacle; }))
+      std::fprintf(stderr,
+                   "tresca: warning: the %s lies under none of the %zu contact nodes (the contact face spans x in "
+                   "(%g, %g], y in [%g, %g] m): nothing can touch it\n",
+                   to_string(s.obstacle.kind), gap.size(), s.x0, s.x0 + s.lx, s.y0, s.y0 + s.ly);
+  }
 }
 
 // the progress lines of a run that is not --quiet

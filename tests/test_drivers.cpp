@@ -145,6 +145,18 @@ TEST(TrescaDriver, WarnsAboutOptionsWithoutEffect) {
   EXPECT_EQ(quiet.out.find("warning: no effect"), std::string::npos) << quiet.out;
 }
 
+// a shaped obstacle under none of the contact nodes (e.g. its centre in
+// millimetres): a valid run in which nothing touches, said before it
+TEST(TrescaDriver, WarnsAboutAnObstacleOffTheContactFace) {
+  expect_run("tresca --dims 8x4x4 --quiet --obstacle cylinder:0.1,5,0", 0,
+             "warning: the cylinder lies under none of the 40 contact nodes");
+  expect_run("tresca --dims 8x4x4 --quiet --obstacle sphere:0.5,1200,500,0", 0,
+             "warning: the sphere lies under none of the 40 contact nodes");
+  const CmdResult under = run("tresca --dims 8x4x4 --quiet --obstacle sphere:0.5,1.2,0.5,0");
+  EXPECT_EQ(under.status, 0) << under.out;
+  EXPECT_EQ(under.out.find("lies under none"), std::string::npos) << under.out;
+}
+
 TEST(TrescaDriver, RunsTheExampleProblemFile) {
   // the repository's commented example: one command, JSON + CSV + VTU, and
   // the JSON says what was solved in the problem file's own schema
