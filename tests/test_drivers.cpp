@@ -88,7 +88,13 @@ TEST(ElasticDriver, RejectsBadInputWithOneLineNamingTheValue) {
 TEST(ElasticDriver, SolvesTheInteriorProblem) {
   const CmdResult r = run("elastic --dims 6x3x3");
   EXPECT_EQ(r.status, 0) << r.out;
-  EXPECT_NE(r.out.find("converged"), std::string::npos);
+  EXPECT_NE(r.out.find("cg              : converged"), std::string::npos) << r.out;
+  // an rtol below double precision's floor: CG's running residual meets it,
+  // the recomputed one cannot (2e-14 at level 6), and the run says so
+  const CmdResult tight = run("elastic --level 6 --rtol 1e-20");
+  EXPECT_EQ(tight.status, 1) << tight.out;
+  EXPECT_NE(tight.out.find("not converged after"), std::string::npos) << tight.out;
+  EXPECT_NE(tight.out.find("the recomputed one did not"), std::string::npos) << tight.out;
 }
 
 TEST(TrescaDriver, RejectsBadOptions) {
