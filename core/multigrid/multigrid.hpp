@@ -166,9 +166,9 @@ class Multigrid : public LinearOperator {
   //   scaled spectrum lies below the larger one's, Cauchy interlacing), so
   //   that a multigrid built `like` this one may share them (the K_ii
   //   solver's, estimated on K with the contact face free, bound the K + B
-  //   of the Newton step's preconditioner: semismooth.hpp; on a mesh one
-  //   element thick, K_ii's own were a third too low for it and its CG
-  //   broke down, perf/RESULTS.md §0zd);
+  //   of the Newton step's preconditioner, boundary_preconditioner.hpp; on
+  //   a mesh one element thick, K_ii's own were a third too low for it and
+  //   its CG broke down, perf/RESULTS.md §0zd);
   // - like: taken from that multigrid (its hierarchy must be `grids`),
   //   whose bounds must hold for op, which also shares its V-cycle's work
   //   vectors (in the same precision): one V-cycle of either may not run
