@@ -469,6 +469,10 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
               N.outer_iterations, N.operator_applications);
   if (N.outer_limit_hits > 0)
     std::printf("note: %d Newton steps were taken with an outer CG stopped at its iteration limit\n", N.outer_limit_hits);
+  if (N.reason == NewtonReason::iteration_limit && N.last_state_changes > 0)
+    std::printf("note: the last step still changed the state of %lld contact nodes (the active set was still moving); "
+                "--max-newton N allows more steps\n",
+                (long long)N.last_state_changes);
   if (N.watchdog_steps > 0)
     std::printf("note: %d Newton steps were taken whole where no step length decreased |w| (the line search's watchdog)\n",
                 N.watchdog_steps);

@@ -410,6 +410,7 @@ class NewtonSolve {
   // the iterate x, and a trial point of the line search (its own bound:
   // Coulomb's bound of a rejected trial must not outlive it)
   Point x, trial;
+  Field<std::uint8_t> last_status;  // x's node states at the last recorded iterate
   // side: [S Δu | E Δu] of the step
   Field<real> du, side, dlambda;
   ReducedSystem L;
@@ -432,6 +433,7 @@ NewtonSolve::NewtonSolve(const SteklovPoincare& S_, const ContactConditions& giv
       nf(S_.full_size()),
       x(p),
       trial(p),
+      last_status(p),
       du(n3),
       side(n3 + nf),
       dlambda(p),
@@ -564,8 +566,19 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
   if (opt.progress) report_progress(S, R, x, k, vnorm, work.iterations, wall_time() - t0, opt.progress);
   if (!std::isfinite(vnorm)) return NewtonReason::non_finite;
   if (vnorm <= tol) return NewtonReason::converged;
+  // the nodes whose state the last step changed, over the ranks (every rank
+  // decides alike): a step that moved the active set and lowered |w| is
+  // progress however slow (a separation front that advances a node a
+  // step: RESULTS.md §0zd), not stagnation
+  const std::uint8_t* now = x.status.data();
+  std::uint8_t* before = last_status.data();
+  const real changed =
+      S.sum(sum_over_entries("newton states changed", p, Cost{2, 1}, [=](index i) { return real(now[i] != before[i]); }));
+  for_each_entry("newton states kept", p, Cost{2, 0}, [=](index i) { before[i] = now[i]; });
+  R.last_state_changes = k > 0 ? index(changed) : 0;
   if (k >= opt.max_iterations) return NewtonReason::iteration_limit;
-  if (stagnated(R.merit, opt.stagnation_window)) return NewtonReason::stagnation;
+  const bool progress = R.last_state_changes > 0 && R.merit[k] < R.merit[k - 1];
+  if (!progress && stagnated(R.merit, opt.stagnation_window)) return NewtonReason::stagnation;
   return std::nullopt;
 }
 

@@ -132,8 +132,10 @@ struct NewtonOptions {
   // the merit and the watchdog may not step, or the best merit of the last
   // stagnation_window steps is not below half the best before them (the
   // round-off floor of an unattainable eps, where the non-monotone search
-  // would let the iterates wander). Off: full steps, and only the second
-  // test.
+  // would let the iterates wander) while the last step did not both change
+  // some node's state and lower the merit (a front of separation that
+  // advances a node or two a step is slow progress, not stagnation; the
+  // iteration limit bounds it). Off: full steps, and only the second test.
   bool line_search = true;
   bool kink_contact = true;  // contact_maps.hpp: ContactLaw::kink_contact
   int line_search_memory = 5;
@@ -200,6 +202,7 @@ struct NewtonResult {
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
   int outer_limit_hits = 0;  // Newton steps whose outer CG stopped at its iteration limit
   int watchdog_steps = 0;    // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
+  index last_state_changes = 0;  // nodes whose contact or stick state the last step changed (all ranks)
   // work in fine-grid matvec equivalents, from the solvers' own counts and
   // cost models (SteklovPoincare::apply_work, BoundaryPreconditioner::apply_work)
   double fine_matvecs = 0;

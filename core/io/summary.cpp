@@ -144,6 +144,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                  {"newton_inner_iterations", N.inner_iterations},
                  {"outer_limit_hits", N.outer_limit_hits},
                  {"watchdog_steps", N.watchdog_steps},
+                 {"last_state_changes", N.last_state_changes},
                  {"fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step()},
                  {"fine_matvecs_solve", R.newton_fine_matvecs()},
                  {"fine_matvecs_total", R.fine_matvecs_total}};

@@ -5,7 +5,8 @@
 // converged, reason, residual_history, final_residual, true_residual,
 // true_residual_relative, times {setup, condense, solve, recover, total},
 // counts {inner_iterations, outer_iterations, operator_applications,
-// newton_inner_iterations, outer_limit_hits, watchdog_steps, fine_matvecs_per_newton_step},
+// newton_inner_iterations, outer_limit_hits, watchdog_steps, last_state_changes,
+// fine_matvecs_per_newton_step},
 // contact {active, separated, sticking, sliding, ux_min, uz_max, lambda_sum},
 // kkt {equilibrium, uz_violation, lambda_violation, complementarity,
 // friction_bound, friction_direction, stick_slip}, peak_memory_bytes.
