@@ -1,6 +1,7 @@
 #include "core/contact/semismooth.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "kernels/contact_maps.hpp"
+#include "kernels/element.hpp"
 #include "kernels/launch.hpp"
 #include "kernels/vector_ops.hpp"
 #include "core/contact/boundary_preconditioner.hpp"
@@ -295,6 +297,18 @@ std::vector<real> step_scale(const SteklovPoincare& S) {
   return s;
 }
 
+real contact_stiffness_bound(const Problem& P) {
+  std::array<real, 576> Ke;
+  brick_stiffness(P.grid.hx(), P.grid.hy(), P.grid.hz(), P.spec.E, P.spec.nu, Ke.data());
+  real row = 0;
+  for (int r = 0; r < 24; ++r) {
+    real sum = 0;
+    for (int q = 0; q < 24; ++q) sum += std::abs(Ke[24 * r + q]);
+    row = std::max(row, sum);
+  }
+  return 4 * row;
+}
+
 bool stagnated(const std::vector<real>& h, int w) {
   const int k = int(h.size());
   if (w <= 0 || k <= w) return false;
@@ -468,11 +482,7 @@ NewtonSolve::NewtonSolve(const SteklovPoincare& S_, const ContactConditions& giv
   }
   if (opt.outer_pc == OuterPreconditioner::multigrid)
     M = std::make_unique<BoundaryPreconditioner>(S, S.mg_options());
-  // S <= K_cc, whose largest eigenvalue is below 4 times its largest
-  // diagonal entry (Gershgorin: the off-diagonal row sums of the Q1
-  // elasticity stencil are 2-3 times the diagonal)
-  for (real sc : R.units) smax = std::max(smax, sc);
-  smax = 4 * S.max(smax);
+  smax = contact_stiffness_bound(S.problem());
 }
 
 NewtonResult NewtonSolve::finish(NewtonReason reason) {

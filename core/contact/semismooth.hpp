@@ -224,6 +224,14 @@ struct ContactConditions {
 // (perf/RESULTS.md), so the plain diagonal of K_cc it is
 std::vector<real> step_scale(const SteklovPoincare& S);
 
+// A bound on the largest eigenvalue of S [N/m], |S x| <= bound |x|: S <= K_cc
+// (a Schur complement of K), whose largest eigenvalue is at most its largest
+// absolute row sum (Gershgorin); a contact node lies in at most 4 bricks,
+// so a row of K_cc sums at most 4 rows of the brick matrix. (4 times the
+// largest diagonal entry, the estimate before, was 4 % under the largest
+// eigenvalue on meshes one element thick.)
+real contact_stiffness_bound(const Problem& P);
+
 // The window test above on the merit history h (window w)
 bool stagnated(const std::vector<real>& h, int w);
 
