@@ -26,6 +26,9 @@ TEST(Nested, CoarserMeshHalvesEveryAxisRoundingUp) {
   EXPECT_FALSE(has_coarser(spec_for_dims(8, 4, 4), 64));  // 4x2x2: 12 contact nodes
   EXPECT_TRUE(has_coarser(spec_for_dims(3, 3, 3), 1));     // 2x2x2
   EXPECT_FALSE(has_coarser(spec_for_dims(2, 2, 2), 1));    // 1x1x1 is too coarse
+  EXPECT_TRUE(has_coarser(spec_for_dims(100, 1, 1), 64));  // 50x1x1: a bar may stay one element thick
+  EXPECT_TRUE(has_coarser(spec_for_dims(64, 32, 2), 64));  // 32x16x1: and a plate
+  EXPECT_FALSE(has_coarser(spec_for_dims(2, 20, 20), 1));  // 1x10x10: x keeps 2 elements
 }
 
 TEST(Nested, ContactAreasTileTheFace) {

@@ -16,7 +16,7 @@ ProblemSpec coarser_spec(const ProblemSpec& s) {
 
 bool has_coarser(const ProblemSpec& s, index min_contact_nodes) {
   const ProblemSpec c = coarser_spec(s);
-  return c.ex < s.ex && c.ex >= 2 && c.ey >= 2 && c.ez >= 2 && c.contact_nodes() >= min_contact_nodes;
+  return c.ex < s.ex && c.ex >= 2 && c.contact_nodes() >= min_contact_nodes;
 }
 
 real contact_area(const GridDims& g, index c) {

@@ -23,7 +23,10 @@ namespace tresca {
 ProblemSpec coarser_spec(const ProblemSpec& s);
 
 // whether nested iteration goes one mesh further down from s: the coarser
-// mesh still has at least min_contact_nodes contact nodes and 2 elements per axis
+// mesh still has at least min_contact_nodes contact nodes and 2 elements
+// along x (y and z may be one element thick: on a bar or a plate the coarse
+// solve places the front of separation that the fine Newton steps would
+// otherwise move a node or two a step, RESULTS.md §0zd)
 bool has_coarser(const ProblemSpec& s, index min_contact_nodes);
 
 // the contact law of the fine problem on the coarse one (densities, above)
