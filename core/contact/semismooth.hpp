@@ -200,8 +200,8 @@ struct NewtonResult {
   StopRule stop = StopRule::consistent;
   bool kink_contact = true;            // the options' kink rule (the status above)
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
-  int outer_limit_hits = 0;  // Newton steps whose outer CG stopped at its iteration limit
-  int watchdog_steps = 0;    // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
+  int outer_limit_hits = 0;      // Newton steps whose outer CG stopped at its iteration limit
+  int watchdog_steps = 0;        // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
   index last_state_changes = 0;  // nodes whose contact or stick state the last step changed (all ranks)
   // work in fine-grid matvec equivalents, from the solvers' own counts and
   // cost models (SteklovPoincare::apply_work, BoundaryPreconditioner::apply_work)
