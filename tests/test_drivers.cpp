@@ -2,6 +2,8 @@
 // and exit status 2; a run that does not converge says so (status 1); output
 // files have the documented content.
 #include <gtest/gtest.h>
+
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
@@ -315,12 +317,22 @@ TEST(TrescaDriver, ASlowFrontOfSeparationIsNotStagnation) {
   // step lets a node or two more separate (31 steps, |w| falling by 5-10 %
   // a step); before, "not converged (stagnation)" after 14 (no halving in
   // 10 steps)
-  expect_run("tresca --dims 100x1x1 --phi 1e7 --quiet --no-nested", 0, "converged after 31 Newton iterations");
+  auto steps = [](const std::string& out) {
+    const std::size_t at = out.find("converged after ");
+    return at == std::string::npos ? -1 : std::atoi(out.c_str() + at + 16);
+  };
+  const CmdResult cold = run("tresca --dims 100x1x1 --phi 1e7 --quiet --no-nested");
+  EXPECT_EQ(cold.status, 0) << cold.out;
+  EXPECT_GE(steps(cold.out), 25) << cold.out;  // (31 when written)
+  EXPECT_LE(steps(cold.out), 40) << cold.out;
   // stopped at the limit while the states still move, the run says so
   expect_run("tresca --dims 100x1x1 --phi 1e7 --quiet --no-nested --max-newton 10", 1,
-             "note: the last step still changed the state of 2 contact nodes");
-  // nested iteration (the coarser bar 50x1x1 first) places the front: 4 steps
-  expect_run("tresca --dims 100x1x1 --phi 1e7 --quiet", 0, "converged after 4 Newton iterations");
+             "note: the last step still changed the state of");
+  // nested iteration (the coarser bar 50x1x1 first) places the front
+  const CmdResult nested = run("tresca --dims 100x1x1 --phi 1e7 --quiet");
+  EXPECT_EQ(nested.status, 0) << nested.out;
+  EXPECT_GE(steps(nested.out), 1) << nested.out;
+  EXPECT_LE(steps(nested.out), 8) << nested.out;  // (4 when written)
 }
 
 TEST(TrescaDriver, NearlyIncompressibleMaterialFailsFastAndSaysWhy) {
