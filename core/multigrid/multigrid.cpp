@@ -35,13 +35,14 @@ GridDims coarsen(const GridDims& g) {
   return c;
 }
 
-// 1 / diag(A) in precision T where the launches run (0 on ghost rows)
+// dinv = 1 / diag(A) in precision T where the launches run (0 on ghost
+// rows), in dinv's own storage where it has the size already (each Newton
+// step's bottom block refreshes it: no new block)
 template <class T>
-Field<T> inverse_diagonal(const ElasticityOperator& A) {
+void inverse_diagonal(const ElasticityOperator& A, Field<T>& dinv) {
   const Field<real> d = A.diagonal();
-  Field<T> dinv(d.size());
+  dinv.resize(d.size());
   reciprocal_or_zero<T>(index(d.size()), d.data(), dinv.data());
-  return dinv;
 }
 
 // local rows [first, last) of slab s as global rows
@@ -211,7 +212,9 @@ Multigrid::Multigrid(std::shared_ptr<const GridHierarchy> grids, const Rediscret
       } else if (bounds_of) {
         const HostLaunches where(on_host(std::size_t(l)));
         const ElasticityOperator A = bounds_of(grids_->levels[l].slab);
-        levels_[l].lmax = estimate_lmax<T>(l, A, inverse_diagonal<T>(A));
+        Field<T> dinv;
+        inverse_diagonal(A, dinv);
+        levels_[l].lmax = estimate_lmax<T>(l, A, dinv);
       }
     }
     build_work<T>(like);
@@ -272,7 +275,7 @@ void Multigrid::refresh_work() {
   D.resize(levels_.size());
   for (size_t l = 0; l < levels_.size(); ++l) {
     const HostLaunches where(on_host(l));
-    D[l] = inverse_diagonal<T>(levels_[l].A);
+    inverse_diagonal(levels_[l].A, D[l]);
   }
 }
 
