@@ -3,12 +3,23 @@
 // Eigen dense factorisations (method.md §2), independent of the matrix-free path.
 #pragma once
 #include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
 #include <vector>
 
 #include "core/fem/assembly.hpp"
 #include "core/fem/problem.hpp"
 
 namespace tresca {
+// the largest eigenvalue of D^{-1} K (of D^{-1/2} K D^{-1/2}, K assembled
+// element by element; its constrained rows are the identity's) by a dense
+// symmetric eigensolver: the oracle of the smoother's spectral bounds
+inline real jacobi_scaled_lmax(const ElasticityOperator& K) {
+  const Eigen::MatrixXd A(assemble(K));
+  const Eigen::VectorXd s = A.diagonal().cwiseInverse().cwiseSqrt();
+  const Eigen::MatrixXd scaled = s.asDiagonal() * A * s.asDiagonal();
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scaled, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+}
+
 struct DenseSchur {
   Eigen::MatrixXd S;
   Eigen::VectorXd b;
