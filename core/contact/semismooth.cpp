@@ -582,10 +582,10 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
   // step: RESULTS.md §0zd), not stagnation
   const std::uint8_t* now = x.status.data();
   std::uint8_t* before = last_status.data();
-  const real changed = S.sum(
-      sum_over_entries("newton states changed", p, Cost{2, 1}, [=](index i) { return real(now[i] != before[i]); }));
+  R.last_state_changes = k == 0 ? 0
+                                : index(S.sum(sum_over_entries("newton states changed", p, Cost{2, 1},
+                                                               [=](index i) { return real(now[i] != before[i]); })));
   for_each_entry("newton states kept", p, Cost{2, 0}, [=](index i) { before[i] = now[i]; });
-  R.last_state_changes = k > 0 ? index(changed) : 0;
   if (k >= opt.max_iterations) return NewtonReason::iteration_limit;
   const bool progress = R.last_state_changes > 0 && R.merit[k] < R.merit[k - 1];
   if (!progress && stagnated(R.merit, opt.stagnation_window)) return NewtonReason::stagnation;
