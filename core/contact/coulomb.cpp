@@ -46,6 +46,7 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, ContactConditions la
     C.last = std::move(R);
     C.law = law;
     const NewtonResult& L = C.last;
+    no.inner_tightening = L.inner_tightening;  // (the next solve starts where this one ended)
     if (!L.converged()) {
       C.reason = CoulombReason::tresca_failed;
       return C;

@@ -77,6 +77,8 @@ void solve_coarser_mesh(const ProblemSpec& spec, const RunOptions& opt, RunResul
                       C.times.total - C.times.nested, on_device});
   R.nested_fine_matvecs = C.fine_matvecs_total * double(cs.free_dofs()) / double(spec.free_dofs());
   if (opt.nested_done) opt.nested_done(R.nested.back());
+  // (a material whose S products need tighter inner solves needs them on every mesh)
+  newton.inner_tightening = std::max(newton.inner_tightening, C.newton.inner_tightening);
   if (!C.converged()) return;
   prolongate_contact(C.problem->grid, C.newton.u, C.newton.lambda, R.problem->grid, start.u0, start.lambda0);
   newton.u0 = &start.u0;

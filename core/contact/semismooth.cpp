@@ -37,17 +37,22 @@ namespace {
 struct InnerWork {
   long long iterations = 0, failures = 0;
   double fine_matvecs = 0;  // SteklovPoincare::apply_work of each application
+  // every inner tolerance is divided by this (>= 1): raised where a step's
+  // system, checked with a fresh S Δu, missed its accuracy
+  // (NewtonSolve::check_step; NewtonResult::inner_tightening)
+  real tightening = 1;
   // one application of S at inner tolerance rtol, counted; false if the inner solve failed
   bool apply(const SteklovPoincare& S, const real* v, real* Sv, real rtol, real* extension = nullptr,
              const real* guess = nullptr) {
-    return count(S, S.apply(v, Sv, rtol, extension, guess));
+    return count(S, S.apply(v, Sv, tight(rtol), extension, guess));
   }
   // r = S u - b̃ (SteklovPoincare::residual), counted the same way
   bool residual(const SteklovPoincare& S, const real* u, real* r, real rtol, real* body, const real* guess) {
-    return count(S, S.residual(u, r, rtol, body, guess));
+    return count(S, S.residual(u, r, tight(rtol), body, guess));
   }
 
  private:
+  real tight(real rtol) const { return std::max(real(1e-12), rtol / tightening); }
   bool count(const SteklovPoincare& S, const SolveStats& st) {
     iterations += st.iterations;
     failures += st.ok() ? 0 : 1;
@@ -59,8 +64,9 @@ struct InnerWork {
 // The reduced Newton system of one step (method.md §4), where the launches run.
 struct ReducedSystem {
   explicit ReducedSystem(index n3)
-      : known(n3), h(n3), rhs(n3), dlambda(n3 / 3), coupling(2 * (n3 / 3)), fixed(n3), free(n3) {}
+      : known(n3), known_product(n3), h(n3), rhs(n3), dlambda(n3 / 3), coupling(2 * (n3 / 3)), fixed(n3), free(n3) {}
   Field<real> known;  // known increments: Δu_τ = v_12 (sticking), Δu_z = v_4 / s (contact)
+  Field<real> known_product;  // S Δu_known as subtracted from rhs (0: not applied)
   Field<real> h;      // H_1 blocks (h11 | h12 | h22) of sliding nodes
   Field<real> rhs;    // r_F: (s I + H_1) v_12 on sliding rows, v_3 + v_4 on separated u_z rows
   Field<real> dlambda;  // Δλ = v_4 (separated), −v_3 (contact: plus (S Δu)_z)
@@ -69,6 +75,13 @@ struct ReducedSystem {
   Field<real> coupling;
   bool coupled = false;
   Field<std::uint8_t> fixed, free;  // per dof: increment known / part of F
+  // what a launch reads of the reduced operator (reduced_rows)
+  struct View {
+    const real *h, *coupling;
+    const std::uint8_t* free;
+    bool coupled;
+  };
+  View view() const { return {h.data(), coupling.data(), free.data(), coupled}; }
 };
 
 // One point x = (u, lambda) of the iteration with r = S u - b̃, its bound
@@ -162,6 +175,17 @@ void subtract_known(const ReducedSystem& L, index p, const real* Sk, real* rhs) 
   });
 }
 
+// The rows of S x + H x (+ F t (S x)_z: Coulomb Newton) at node i, from sx = (S x)_i
+inline void reduced_rows(index p, index i, const real sx[3], const real* x, const ReducedSystem::View& L, real y[3]) {
+  y[0] = sx[0] + L.h[i] * x[i] + L.h[p + i] * x[p + i];
+  y[1] = sx[1] + L.h[p + i] * x[i] + L.h[2 * p + i] * x[p + i];
+  y[2] = sx[2];
+  if (L.coupled) {
+    y[0] += L.coupling[i] * y[2];
+    y[1] += L.coupling[p + i] * y[2];
+  }
+}
+
 // y = mask_F (S x + H x (+ F t (S x)_z: Coulomb Newton)), with the side
 // product [S x | E x] (3p + S.full_size()): the CG accumulates both along its
 // iterate, so after the step it holds the running S Δu_F, whose norm sets the
@@ -186,20 +210,12 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
   void apply(const real* x, real* y, real* Sx, real* extension) const {
     work_.apply(S_, x, Sx, rtol_, extension);
     const index p = S_.size() / 3;
-    const real *h = L_.h.data(), *coupling = L_.coupling.data();
-    const std::uint8_t* free = L_.free.data();
-    const bool coupled = L_.coupled;
+    const ReducedSystem::View L = L_.view();
     for_each_entry("newton-step operator", p, Cost{123, 12}, [=](index i) {
-      real y1 = Sx[i] + h[i] * x[i] + h[p + i] * x[p + i];
-      real y2 = Sx[p + i] + h[p + i] * x[i] + h[2 * p + i] * x[p + i];
-      const real y3 = Sx[2 * p + i];
-      if (coupled) {
-        y1 += coupling[i] * y3;
-        y2 += coupling[p + i] * y3;
-      }
-      y[i] = free[i] ? y1 : 0;
-      y[p + i] = free[p + i] ? y2 : 0;
-      y[2 * p + i] = free[2 * p + i] ? y3 : 0;
+      const real sx[3] = {Sx[i], Sx[p + i], Sx[2 * p + i]};
+      real yi[3];
+      reduced_rows(p, i, sx, x, L, yi);
+      for (int a = 0; a < 3; ++a) y[a * p + i] = L.free[a * p + i] ? yi[a] : 0;
     });
   }
 
@@ -213,6 +229,7 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
 // The result of solving one reduced Newton system.
 struct StepOutcome {
   SolveStats outer;
+  real rhs_norm = 0, target = 0;  // |r_F|, and the accuracy asked of the system's residual
   bool inner_failed = false;
   bool known_applied = false;  // S was applied to the known increments
 };
@@ -247,13 +264,17 @@ StepOutcome solve_step(const SteklovPoincare& S, ReducedSystem& L, BoundaryPreco
       return out;
     }
     subtract_known(L, n3 / 3, known, L.rhs.data());
+    copy(n3, known, L.known_product.data());
   } else {
     fill<real>(n3 + nf, 0, known);
+    fill<real>(n3, 0, L.known_product.data());
   }
   if (M) M->update(L.h, L.fixed, L.free);
   ReducedNewtonOperator A(S, L, work);
   CGOptions co;
-  const real target = std::max(floor, eta * norm(L.rhs.data()));
+  out.rhs_norm = norm(L.rhs.data());
+  const real target = std::max(floor, eta * out.rhs_norm);
+  out.target = target;
   co.rtol = 1e-13;  // attainable floor relative to |rhs|
   co.atol = target;
   co.max_iterations = M ? 200 : 5000;
@@ -331,6 +352,9 @@ void check_inputs(index p, index nf, const ContactConditions& law, const NewtonO
   if (opt.lambda0 && index(opt.lambda0->size()) != p) size_error("lambda0", opt.lambda0->size(), p);
   if (opt.r0 && index(opt.r0->size()) != n3) size_error("r0", opt.r0->size(), n3);
   if (opt.body0 && index(opt.body0->size()) != nf) size_error("body0", opt.body0->size(), nf);
+  if (!(opt.inner_tightening >= 1 && std::isfinite(opt.inner_tightening)))
+    throw std::invalid_argument("semismooth_newton: inner_tightening " + std::to_string(opt.inner_tightening) +
+                                " must be >= 1 and finite");
   if (opt.r0 && !(opt.body0 && opt.force_scale > 0))
     throw std::invalid_argument("semismooth_newton: r0 needs the body it came from (body0) and force_scale");
   const std::vector<real>& phi = law.phi;
@@ -409,6 +433,7 @@ class NewtonSolve {
   std::optional<NewtonReason> record(int k);
   std::optional<NewtonReason> newton_step();
   std::optional<NewtonReason> take_step();
+  void check_step(const real* Sdu);
 
   const SteklovPoincare& S;
   const NewtonOptions& opt;
@@ -432,6 +457,7 @@ class NewtonSolve {
   CGWorkspace ws;
   real smax = 0;  // |S x| <= smax |x|
   bool last_step_hit_limit = false;
+  real step_rhs = 0, step_target = 0;  // the last step's |r_F| and accuracy asked (StepOutcome)
   int last_watchdog = std::numeric_limits<int>::min() / 2;  // the last step the watchdog took whole
   real eta;
   // this iteration's |v̂|, merit |w| and tolerance
@@ -465,6 +491,7 @@ NewtonSolve::NewtonSolve(const SteklovPoincare& S_, const ContactConditions& giv
   // the final report's status. The residual in consistent units is measured
   // in the stiffness of the diagonal metric whatever the step's metric.
   R.units = step_scale(S);
+  work.tightening = opt.inner_tightening;
   R.stop = opt.stop;
   R.kink_contact = opt.kink_contact;
   units = placed_field<real>(R.units);
@@ -494,6 +521,7 @@ NewtonResult NewtonSolve::finish(NewtonReason reason) {
   R.phi = x.phi.to_vector();
   R.inner_iterations = work.iterations;
   R.fine_matvecs = work.fine_matvecs;
+  R.inner_tightening = work.tightening;
   return std::move(R);
 }
 
@@ -599,6 +627,8 @@ std::optional<NewtonReason> NewtonSolve::newton_step() {
   const bool any_known = S.max(linearise(p, scale_ptr, x, opt.friction, L) ? 1 : 0) > 0;
   const StepOutcome step = solve_step(S, L, M.get(), eta, 0.1 * tol, smax, any_known, work, ws, du, side);
   R.outer_iterations += step.outer.iterations;
+  step_rhs = step.rhs_norm;
+  step_target = step.target;
   R.operator_applications += step.outer.iterations + (step.known_applied ? 1 : 0);
   if (step.inner_failed) return NewtonReason::inner_failure;
   if (step.outer.reason == SolveReason::non_finite) return NewtonReason::non_finite;
@@ -631,6 +661,7 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
   R.operator_applications += 1;
   if (!work.apply(S, du.data(), Sdu, inc_rtol, Edu, Edu)) return NewtonReason::inner_failure;
   r_err = std::max(r_err, accuracy);
+  check_step(Sdu);
   {  // Δλ: the known part, plus (S Δu)_z on contact nodes
     const real* known_part = L.dlambda.data();
     const std::uint8_t* status = x.status.data();
@@ -670,6 +701,40 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
   axpy(n3, alpha, Sdu, x.r.data());
   axpy(nf, alpha, Edu, R.body.data());
   return std::nullopt;
+}
+
+// The step's system checked with the fresh S Δu (of the whole step, less
+// the known increments' S Δu_known as subtracted from r_F): the residual
+// |mask_F (S Δu_F + H Δu (+ F t (S Δu_F)_z)) − r_F|. The outer solve met
+// `step_target` = eta |r_F| with the S products of its relaxed inner
+// solves, whose tolerance is relative to the interior load K_ic x. Where
+// S x = K_cc x − K_ci K_ii⁻¹ K_ic x is much smaller than its two terms (a
+// material near ν = −1, whose bulk modulus is a hundredth of its shear
+// modulus), that tolerance buys less accuracy in S x, the step misses its
+// target by the factor lost, and Newton converges only linearly, at about
+// that factor times eta (ν = −0.97: 49 steps at level 7, and stagnation at
+// ν = −0.99; RESULTS.md §0ze). A step whose residual is left above a tenth
+// of r_F (it did not remove 90 % of its own linear model's residual)
+// tightens every later inner tolerance by the factor it missed its target
+// by. The steps of ordinary materials leave at most 0.09 |r_F| (a cold
+// start's free fall over a gap; most below 0.01) and never tighten.
+void NewtonSolve::check_step(const real* Sdu) {
+  const ReducedSystem::View V = L.view();
+  const real *dU = du.data(), *Sk = L.known_product.data(), *rhs = L.rhs.data();
+  const index np = p;
+  const real missed = std::sqrt(S.sum(sum_over_entries("newton-step check", p, Cost{131, 20}, [=](index i) {
+    const real sx[3] = {Sdu[i] - Sk[i], Sdu[np + i] - Sk[np + i], Sdu[2 * np + i] - Sk[2 * np + i]};
+    real y[3];
+    reduced_rows(np, i, sx, dU, V, y);
+    real e = 0;
+    for (int a = 0; a < 3; ++a) {
+      const real d = V.free[a * np + i] ? y[a] - rhs[a * np + i] : 0;
+      e += d * d;
+    }
+    return e;
+  })));
+  if (missed > std::max(real(0.1) * step_rhs, step_target) && step_target > 0)
+    work.tightening = std::min(work.tightening * missed / step_target, real(1e8));
 }
 
 NewtonResult NewtonSolve::run() {

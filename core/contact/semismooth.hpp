@@ -169,6 +169,10 @@ struct NewtonOptions {
   // residual_accuracy, e.g. an earlier solve's NewtonResult::r and ::body
   const std::vector<real>* r0 = nullptr;
   real r0_accuracy = 0;  // r0's accuracy relative to force_scale (0: residual_accuracy)
+  // the divisor (>= 1) of every inner tolerance to start from, which the
+  // solve raises where a step misses its accuracy (NewtonResult::inner_tightening):
+  // nested iteration and the Coulomb fixed point pass on an earlier solve's
+  real inner_tightening = 1;
   // Tresca: the law's bounds phi. Coulomb lagged: phi_i = F lambda_i of the
   // current iterate before every approximation step (the law's phi is then
   // ignored); ||v̂|| with that bound is the Coulomb problem's own residual,
@@ -203,6 +207,9 @@ struct NewtonResult {
   int outer_limit_hits = 0;      // Newton steps whose outer CG stopped at its iteration limit
   int watchdog_steps = 0;        // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
   index last_state_changes = 0;  // nodes whose contact or stick state the last step changed (all ranks)
+  // the factor (>= 1) by which the steps' inner tolerances were tightened
+  // where a step's system, checked with a fresh S Δu, missed its accuracy
+  real inner_tightening = 1;
   // work in fine-grid matvec equivalents, from the solvers' own counts and
   // cost models (SteklovPoincare::apply_work, BoundaryPreconditioner::apply_work)
   double fine_matvecs = 0;

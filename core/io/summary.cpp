@@ -145,6 +145,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                  {"outer_limit_hits", N.outer_limit_hits},
                  {"watchdog_steps", N.watchdog_steps},
                  {"last_state_changes", N.last_state_changes},
+                 {"inner_tightening", N.inner_tightening},
                  {"fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step()},
                  {"fine_matvecs_solve", R.newton_fine_matvecs()},
                  {"fine_matvecs_total", R.fine_matvecs_total}};

@@ -6,6 +6,7 @@
 // true_residual_relative, times {setup, condense, solve, recover, total},
 // counts {inner_iterations, outer_iterations, operator_applications,
 // newton_inner_iterations, outer_limit_hits, watchdog_steps, last_state_changes,
+// inner_tightening,
 // fine_matvecs_per_newton_step},
 // contact {active, separated, sticking, sliding, ux_min, uz_max, lambda_sum},
 // kkt {equilibrium, uz_violation, lambda_violation, complementarity,
