@@ -25,7 +25,11 @@
 // safeguarded, so eta_k -> 0 and the convergence stays superlinear), floored
 // at 0.1 eps. Its inner (K_ii) solves are relaxed as the outer residual r_j
 // falls: inner rtol_j = clamp(target / ||r_j||, 1e-12, 1e-2) (a safety factor 0.1 cost
-// 6-13% more work and saved no Newton step, perf/RESULTS.md §0c). The
+// 6-13% more work and saved no Newton step, perf/RESULTS.md §0c); each
+// step's system is checked with its fresh S Δu, and a step that missed its
+// accuracy by leaving more than a tenth of r_F (S a small difference of
+// large terms: ν near −1) divides every later inner tolerance by the
+// factor missed (NewtonResult::inner_tightening, §0ze). The
 // residual r needs the accuracy of its use: residual_fraction eta_k |v̂_k|
 // absolute for the step it decides (an error of that size is a part of the
 // step's own inexactness), and residual_accuracy |b̃| before |v̂| <= eps is
