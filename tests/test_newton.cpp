@@ -427,8 +427,8 @@ TEST(SemismoothNewton, AnAuxeticMaterialTightensTheInnerSolvesItsStepsNeed) {
   o.nested = false;
   const RunResult R = run_tresca(spec, o);
   ASSERT_TRUE(R.converged()) << R.reason();
-  EXPECT_GT(R.newton.inner_tightening, 10);  // (48 when written)
-  EXPECT_LE(R.newton.iterations, 14);        // (11 when written)
+  EXPECT_GT(R.newton.inner_tightening, 3);  // (12 when written)
+  EXPECT_LE(R.newton.iterations, 14);       // (10 when written)
   // the dense reference (exact solves) reaches the same solution (to 1e-4
   // N, 1e-12 of its forces: the dense S of this material carries rounding
   // errors of its large terms, and stalls at 5e-6 N)
