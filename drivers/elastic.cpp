@@ -44,7 +44,13 @@ int main(int argc, char** argv) {
     warn_if_cores_busy();
     const double t0 = wall_time();
     const Problem P = make_problem(spec);  // every rank builds the whole load
-    const Multigrid mg(P.grid, P.interior_faces, spec.E, spec.nu, MGOptions{}, comm);
+    MGOptions mo;
+    const std::string why_double = why_double_precision(spec);
+    if (!why_double.empty()) {
+      mo.precision = Precision::double_precision;
+      if (comm.rank() == 0) std::fprintf(stderr, "elastic: note: %s\n", why_double.c_str());
+    }
+    const Multigrid mg(P.grid, P.interior_faces, spec.E, spec.nu, mo, comm);
     comm.barrier();
     const double t1 = wall_time();
     const InteriorSolution sol = solve_interior_elasticity(P, mg, rtol);

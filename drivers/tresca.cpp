@@ -133,6 +133,7 @@ struct Command {
   bool every_iteration = false, quiet = false, profile = false;
   std::vector<real> initial_u, initial_lambda;  // --initial: u0 (3p SoA), lambda0 (p)
   std::vector<std::string> no_effect;  // options given that change nothing here (warned about)
+  std::string why_double;              // single-precision V-cycles asked, double chosen: why (warned about)
 };
 
 // a failed write of an output: exit status 3
@@ -266,6 +267,12 @@ void parse_command(const Args& a, const Comm& comm, Command& c) {
   if (a.has("--initial")) read_initial_iterate(a, c);
   newton_options_from(a, table, c.opt.newton);
   multigrid_options_from(a, c.opt.mg);
+  // (a float overflows at E = 1e40 Pa and underflows under loads of 1e-40:
+  // there the V-cycles run in double)
+  if (c.opt.mg.precision == Precision::single_precision) {
+    c.why_double = why_double_precision(c.spec);
+    if (!c.why_double.empty()) c.opt.mg.precision = Precision::double_precision;
+  }
   friction_from(a, table, c.opt.friction);
   c.opt.nested = !a.has("--no-nested") && !table;  // --table: the paper's cold start
   if (a.has("--coulomb-method") && !c.opt.friction.is_coulomb())
@@ -300,6 +307,7 @@ void warn_about(const Command& c) {
                  "tresca: warning: nu = %g is nearly incompressible: Q1 elements lock and the multigrid inner solver "
                  "degrades (it may fail to converge)\n",
                  c.spec.nu);
+  if (!c.why_double.empty()) std::fprintf(stderr, "tresca: note: %s\n", c.why_double.c_str());
   // a sphere or cylinder placed off the face (a unit slip, a sign): the body
   // then moves freely, a valid run that is rarely what was meant
   const ProblemSpec& s = c.spec;

@@ -233,6 +233,18 @@ TEST(TrescaDriver, TakesATinyButNonzeroNumber) {
   expect_run("tresca --dims 4x2x2 --quiet --phi 1e-320", 0, "");
 }
 
+TEST(TrescaDriver, UnitsBeyondAFloatsRangeRunTheVCyclesInDoubleAndSaySo) {
+  // E = 1e40 Pa overflowed the single-precision V-cycle (exit 1,
+  // inner_solver_failure, |b| printed as 0), as did loads scaled by 1e-40
+  // (RESULTS.md §0ze); the answer in u scales as 1/E
+  const char* note = "note: the multigrid V-cycles run in double precision";
+  expect_run("tresca --dims 8x4x4 --quiet --E 1e40", 0, note);
+  expect_run("tresca --dims 8x4x4 --quiet --load-scale 1e-40", 0, note);
+  expect_run("elastic --dims 8x4x4 --E 1e-40", 0, note);
+  const CmdResult plain = run("tresca --dims 8x4x4 --quiet");
+  EXPECT_EQ(plain.out.find(note), std::string::npos) << plain.out;
+}
+
 TEST(TrescaDriver, WithoutLoadTheBodyStaysAtRest) {
   // b~ = 0: nested iteration (and the Coulomb fixed point) once stopped with
   // "an initial iterate u0 needs force_scale" (exit 2); u = 0, lambda = 0

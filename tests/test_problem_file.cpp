@@ -1,10 +1,13 @@
 // Problem files (core/io/problem_file.hpp): defaults, every key read back,
-// the loads they give, and one-line errors that name the key.
+// the loads they give, and one-line errors that name the key; the scales of
+// a problem (problem.hpp: scales_of) and where single precision holds them.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 #include <numeric>
+#include <utility>
+#include <vector>
 
 #include "core/io/problem_file.hpp"
 
@@ -104,6 +107,33 @@ TEST(ProblemFile, LoadsAreConsistentNodalForces) {
       global_to_local(s, load.data(), expect.data());
       EXPECT_EQ(std::vector<real>(part.begin(), part.end()), expect) << "rank " << rank << " of " << ranks;
     }
+}
+
+TEST(ProblemScales, MatchTheClosedFormsAndSayWhereSinglePrecisionHolds) {
+  // cubes of edge h = 0.25: the Q1 brick's diagonal is h (lambda + 4 mu) / 9
+  // (each integral of a squared shape-function derivative is h / 9); the
+  // x1 face's traction 5e8 Pa gives a node 5e8 h^2 / 4 from each element
+  ProblemSpec s = spec_for_dims(8, 4, 4);
+  s.lz = 1;
+  const real h = 0.25, mu = s.E / (2 * (1 + s.nu)), lambda = s.E * s.nu / ((1 + s.nu) * (1 - 2 * s.nu));
+  const ProblemScales sc = scales_of(s);
+  EXPECT_NEAR(sc.stiffness_min, h * (lambda + 4 * mu) / 9, 1e-9 * sc.stiffness_min);
+  EXPECT_GE(sc.stiffness_max, sc.stiffness_min);
+  EXPECT_LT(sc.stiffness_max, 2 * sc.stiffness_min);  // (the diagonal dominates the brick's entries)
+  EXPECT_NEAR(sc.force, 5e8 * h * h / 4, 1e-6);
+  EXPECT_NEAR(sc.displacement_max, sc.force / sc.stiffness_min, 1e-12);
+  EXPECT_TRUE(fits_single_precision(sc));
+  // E = 1e40 Pa overflows a float, E = 1e-40 Pa and loads of 1e-40 underflow
+  // (measured: RESULTS.md §0ze); no load fits whatever the material
+  for (auto change : std::vector<std::pair<real, real>>{{1e40, 1}, {1e-40, 1}, {2.1e9, 1e-40}, {2.1e9, 1e40}}) {
+    ProblemSpec t = s;
+    t.E = change.first;
+    t.load_scale = change.second;
+    EXPECT_FALSE(fits_single_precision(scales_of(t))) << "E " << t.E << " load scale " << t.load_scale;
+  }
+  s.load_scale = 0;
+  EXPECT_EQ(scales_of(s).force, 0);
+  EXPECT_TRUE(fits_single_precision(scales_of(s)));
 }
 
 TEST(ProblemFile, ErrorsNameTheKey) {

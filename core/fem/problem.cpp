@@ -1,14 +1,41 @@
 #include "core/fem/problem.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+
+#include "kernels/element.hpp"
 
 namespace tresca {
 
 namespace {
 [[noreturn]] void fail(const std::string& what) { throw std::invalid_argument(what); }
 }  // namespace
+
+ProblemScales scales_of(const ProblemSpec& s) {
+  const real hx = s.lx / real(s.ex), hy = s.ly / real(s.ey), hz = s.lz / real(s.ez);
+  std::array<real, 576> Ke;
+  brick_stiffness(hx, hy, hz, s.E, s.nu, Ke.data());
+  ProblemScales sc;
+  sc.stiffness_min = INFINITY;
+  for (int i = 0; i < 24; ++i) sc.stiffness_min = std::min(sc.stiffness_min, Ke[25 * i]);
+  for (real k : Ke) sc.stiffness_max = std::max(sc.stiffness_max, std::abs(k));
+  const real area[kLoadFaces] = {hy * hz, hx * hz, hx * hz, hx * hy};  // x1, y0, y1, z1
+  for (int f = 0; f < kLoadFaces; ++f)
+    for (real t : s.traction[f]) sc.force = std::max(sc.force, std::abs(t) * area[f] / 4);
+  for (real b : s.body_force) sc.force = std::max(sc.force, std::abs(b) * hx * hy * hz / 8);
+  sc.force *= s.load_scale;
+  sc.displacement_max = sc.force / sc.stiffness_min;
+  sc.displacement_min = sc.force / sc.stiffness_max;
+  return sc;
+}
+
+bool fits_single_precision(const ProblemScales& sc) {
+  auto held = [](real q) { return q >= 1e-28 && q <= 1e31; };
+  if (!held(sc.stiffness_max) || !held(sc.stiffness_min)) return false;
+  return sc.force == 0 || (held(sc.force) && held(sc.displacement_max) && held(sc.displacement_min));
+}
 
 std::array<index, 3> level_dims(int level) {
   const double s = std::pow(2.0, level / 2.0);

@@ -82,6 +82,22 @@ ProblemSpec spec_for_dims(index ex, index ey, index ez);
 // Throws std::invalid_argument naming the offending value.
 void validate(const ProblemSpec& s);
 
+// The magnitudes a solve of s computes with: the brick matrix's largest
+// entry and smallest diagonal entry [N/m], the largest load one element
+// gives a node [N] (0 without load; a node's is up to 8 of them) and the
+// displacements it makes at those stiffnesses [m].
+struct ProblemScales {
+  real stiffness_max = 0, stiffness_min = 0, force = 0, displacement_max = 0, displacement_min = 0;
+};
+ProblemScales scales_of(const ProblemSpec& s);
+// Whether single-precision V-cycles (floats: 1.2e-38 to 3.4e38) hold them
+// with room: each within 1e-28 to 1e31. Measured on level 5 (RESULTS.md
+// §0ze): they failed (overflow or underflow) at a stiffness of 2e34 and of
+// 2e-36 N/m, nodal loads of 8e37 N and displacements of 2e-34 m, and held
+// at 2e32, 2e-30, 8e35 and 2e-32. The benchmark's are 4e7 N/m, 8e5 N and
+// 2e-2 m.
+bool fits_single_precision(const ProblemScales& sc);
+
 // Contact node c = (ix - 1) + ex iy, 1 <= ix <= ex, on the bottom face:
 // its grid node and its position (x, y)
 inline index contact_grid_node(const GridDims& g, index c) { return g.node(1 + c % g.ex, c / g.ex, 0); }

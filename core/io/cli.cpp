@@ -365,6 +365,18 @@ std::string apply_device(const Args& a, const Comm& comm) {
   return "gpu, " + device_description();
 }
 
+std::string why_double_precision(const ProblemSpec& s) {
+  const ProblemScales sc = scales_of(s);
+  if (fits_single_precision(sc)) return "";
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "the multigrid V-cycles run in double precision: this problem's magnitudes (stiffness %.1e to "
+                "%.1e N/m, nodal loads %.1e N, displacements %.1e to %.1e m) are not all within 1e-28 to 1e31, "
+                "what single precision holds with room",
+                sc.stiffness_min, sc.stiffness_max, sc.force, sc.displacement_min, sc.displacement_max);
+  return text;
+}
+
 std::string dims_string(const ProblemSpec& s) {
   return std::to_string(s.ex) + "x" + std::to_string(s.ey) + "x" + std::to_string(s.ez);
 }
