@@ -485,8 +485,8 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
     std::printf("note: %d Newton steps were taken whole where no step length decreased |w| (the line search's watchdog)\n",
                 N.watchdog_steps);
   if (N.inner_tightening > 1)
-    std::printf("note: the Newton steps' inner solves were tightened %.3gx: a step solved with the default inner "
-                "tolerance missed its accuracy when checked with a fresh S du (S is much smaller than its terms, "
+    std::printf("note: the Newton steps' inner solves were tightened %.3gx: steps solved with the default inner "
+                "tolerance missed their accuracy when checked with a fresh S du (S is much smaller than its terms, "
                 "e.g. nu near -1)\n",
                 N.inner_tightening);
   char device_peak[64] = "";

@@ -419,7 +419,7 @@ TEST(SemismoothNewton, AnAuxeticMaterialTightensTheInnerSolvesItsStepsNeed) {
   // instead of eta = 1 %, and Newton converged linearly: 19 steps here
   // from x0 = 0 (16 on 12x6x6; stagnation on 23x12x12 and at level 9).
   // Each step is now checked with its fresh S du, and the inner solves
-  // tightened by the factor a step missed (NewtonSolve::check_step)
+  // tightened by the factor two steps in a row missed (NewtonSolve::check_step)
   ProblemSpec spec = spec_for_dims(16, 8, 8);
   spec.nu = -0.99;
   RunOptions o;

@@ -26,10 +26,10 @@
 // at 0.1 eps. Its inner (K_ii) solves are relaxed as the outer residual r_j
 // falls: inner rtol_j = clamp(target / ||r_j||, 1e-12, 1e-2) (a safety factor 0.1 cost
 // 6-13% more work and saved no Newton step, perf/RESULTS.md §0c); each
-// step's system is checked with its fresh S Δu, and a step that missed its
-// accuracy by leaving more than a tenth of r_F (S a small difference of
-// large terms: ν near −1) divides every later inner tolerance by the
-// factor missed (NewtonResult::inner_tightening, §0ze). The
+// step's system is checked with its fresh S Δu, and two steps in a row
+// that missed their accuracy, leaving more than a tenth of r_F (S a small
+// difference of large terms: ν near −1), divide every later inner
+// tolerance by the factor missed (NewtonResult::inner_tightening, §0ze). The
 // residual r needs the accuracy of its use: residual_fraction eta_k |v̂_k|
 // absolute for the step it decides (an error of that size is a part of the
 // step's own inexactness), and residual_accuracy |b̃| before |v̂| <= eps is
@@ -174,7 +174,7 @@ struct NewtonOptions {
   const std::vector<real>* r0 = nullptr;
   real r0_accuracy = 0;  // r0's accuracy relative to force_scale (0: residual_accuracy)
   // the divisor (>= 1) of every inner tolerance to start from, which the
-  // solve raises where a step misses its accuracy (NewtonResult::inner_tightening):
+  // solve raises where steps miss their accuracy (NewtonResult::inner_tightening):
   // nested iteration and the Coulomb fixed point pass on an earlier solve's
   real inner_tightening = 1;
   // Tresca: the law's bounds phi. Coulomb lagged: phi_i = F lambda_i of the
@@ -212,7 +212,7 @@ struct NewtonResult {
   int watchdog_steps = 0;        // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
   index last_state_changes = 0;  // nodes whose contact or stick state the last step changed (all ranks)
   // the factor (>= 1) by which the steps' inner tolerances were tightened
-  // where a step's system, checked with a fresh S Δu, missed its accuracy
+  // where two steps in a row, checked with a fresh S Δu, missed their accuracy
   real inner_tightening = 1;
   // work in fine-grid matvec equivalents, from the solvers' own counts and
   // cost models (SteklovPoincare::apply_work, BoundaryPreconditioner::apply_work)
