@@ -485,10 +485,11 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
     std::printf("note: %d Newton steps were taken whole where no step length decreased |w| (the line search's watchdog)\n",
                 N.watchdog_steps);
   if (N.inner_tightening > 1)
-    std::printf("note: the Newton steps' inner solves were tightened %.3gx: steps solved with the default inner "
-                "tolerance missed their accuracy when checked with a fresh S du (S is much smaller than its terms, "
-                "e.g. nu near -1)\n",
-                N.inner_tightening);
+    std::printf(
+        "note: the Newton steps' inner solves were tightened %.3gx: steps solved with the default inner "
+        "tolerance missed their accuracy when checked with a fresh S du (S is much smaller than its terms, "
+        "e.g. nu near -1)\n",
+        N.inner_tightening);
   char device_peak[64] = "";
   if (R.peak_device_memory > 0)
     std::snprintf(device_peak, sizeof device_peak, ", device Fields at most %.2f GB", R.peak_device_memory / 1e9);

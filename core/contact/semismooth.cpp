@@ -737,8 +737,10 @@ void NewtonSolve::check_step(const real* Sdu) {
     return e;
   })));
   // (a factor > 1 where the step left more than a tenth of r_F, else 0)
-  const real factor = missed > std::max(real(0.1) * step_rhs, step_target) && step_target > 0 ? missed / step_target : 0;
-  if (factor > 0 && last_missed > 0) work.tightening = std::min(work.tightening * std::min(factor, last_missed), real(1e8));
+  const real factor =
+      missed > std::max(real(0.1) * step_rhs, step_target) && step_target > 0 ? missed / step_target : 0;
+  if (factor > 0 && last_missed > 0)
+    work.tightening = std::min(work.tightening * std::min(factor, last_missed), real(1e8));
   last_missed = factor;
 }
 
