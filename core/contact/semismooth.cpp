@@ -739,8 +739,13 @@ void NewtonSolve::check_step(const real* Sdu) {
   // (a factor > 1 where the step left more than a tenth of r_F, else 0)
   const real factor =
       missed > std::max(real(0.1) * step_rhs, step_target) && step_target > 0 ? missed / step_target : 0;
-  if (factor > 0 && last_missed > 0)
-    work.tightening = std::min(work.tightening * std::min(factor, last_missed), real(1e8));
+  if (factor > 0 && last_missed > 0) {
+    const real tighter = std::min(work.tightening * std::min(factor, last_missed), real(1e8));
+    // r's increments so far were that much less accurate than counted: its
+    // error bound grows alike, so that r is refreshed before it is believed
+    r_err *= tighter / work.tightening;
+    work.tightening = tighter;
+  }
   last_missed = factor;
 }
 
