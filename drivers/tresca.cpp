@@ -308,6 +308,13 @@ void warn_about(const Command& c) {
                  "degrades (it may fail to converge)\n",
                  c.spec.nu);
   if (!c.why_double.empty()) std::fprintf(stderr, "tresca: note: %s\n", c.why_double.c_str());
+  const real flat = unresolved_anisotropy(grid_of(c.spec), c.opt.mg.coarse_nodes);
+  if (flat > 4)
+    std::fprintf(stderr,
+                 "tresca: warning: the elements are up to %.3g times wider than the body is thick (a thin plate of "
+                 "wide elements): multigrid cannot coarsen that away and the Newton steps' solver may stall or fail; "
+                 "elements at most 4 times wider than the thickness avoid it\n",
+                 flat);
   // a sphere or cylinder placed off the face (a unit slip, a sign): the body
   // then moves freely, a valid run that is rarely what was meant
   const ProblemSpec& s = c.spec;

@@ -339,6 +339,33 @@ TEST(MultigridCG, SemiCoarseningKeepsAnisotropicMeshesFast) {
   }
 }
 
+TEST(Coarsening, SaysWhereAThinPlateOfWideElementsLeavesAnisotropyBehind) {
+  // a plate 2 x 1 x 0.02 m of 16x8x2 elements: z coarsens to one element
+  // (0.02 m thick) while x and y keep 0.125 m: 6.25, and the contact
+  // solve's boundary V-cycle stalls (RESULTS.md §0ze); with 32x16x4, 3.125
+  // (it converges); the benchmark's levels, bars, plates thick across their
+  // elements and the semi-coarsened meshes above leave none
+  auto plate = [](index ex, index ey, index ez, real lz) {
+    ProblemSpec s = spec_for_dims(ex, ey, ez);
+    s.lz = lz;
+    return unresolved_anisotropy(grid_of(s));
+  };
+  EXPECT_NEAR(plate(16, 8, 2, 0.02), 0.125 / 0.02, 1e-9);
+  EXPECT_NEAR(plate(32, 16, 4, 0.02), 0.0625 / 0.02, 1e-9);
+  EXPECT_NEAR(plate(16, 8, 2, 0.01), 0.125 / 0.01, 1e-9);
+  for (int level = 0; level <= 12; ++level) EXPECT_LT(unresolved_anisotropy(grid_of(spec_for_level(level))), 1.5);
+  const index sizes[][3] = {{100, 1, 1}, {1000, 2, 1}, {64, 32, 1}, {256, 2, 2}, {8, 8, 200}, {200, 100, 2}};
+  for (auto& e : sizes)
+    EXPECT_LT(unresolved_anisotropy(grid_of(spec_for_dims(e[0], e[1], e[2]))), 4) << e[0] << "x" << e[1] << "x" << e[2];
+  // the plate's first coarsening halves its thickness's elements alone
+  ProblemSpec thin = spec_for_dims(16, 8, 2);
+  thin.lz = 0.02;
+  const std::vector<GridDims> levels = coarsening(grid_of(thin));
+  ASSERT_GE(levels.size(), 2u);
+  EXPECT_EQ(levels[1].ez, 1);
+  EXPECT_EQ(levels[1].ex, 16);
+}
+
 TEST(CG, ReportsMaxIterationsInsteadOfLooping) {
   const Problem P = make_problem(spec_for_level(4));
   ElasticityOperator A(P.grid, P.interior_faces, P.spec.E, P.spec.nu);

@@ -125,6 +125,31 @@ std::string rank_layout(const GridDims& g, const Comm& comm, const std::string& 
          " nodes a rank";
 }
 
+std::vector<GridDims> coarsening(const GridDims& fine, index coarse_nodes) {
+  std::vector<GridDims> grids;
+  GridDims g = fine;
+  for (;;) {
+    grids.push_back(g);
+    if (g.nodes() <= coarse_nodes || (g.ex == 1 && g.ey == 1 && g.ez == 1)) break;
+    g = coarsen(g);
+  }
+  return grids;
+}
+
+real unresolved_anisotropy(const GridDims& fine, index coarse_nodes) {
+  for (const GridDims& g : coarsening(fine, coarse_nodes)) {
+    const index e[3] = {g.ex, g.ey, g.ez};
+    const real h[3] = {g.hx(), g.hy(), g.hz()};
+    const int thin = int(std::min_element(h, h + 3) - h);
+    if (e[thin] > 1) continue;  // (the thin axis still coarsens)
+    real worst = 1;
+    for (int a = 0; a < 3; ++a)
+      if (e[a] > 1) worst = std::max(worst, h[a] / h[thin]);
+    return worst;
+  }
+  return 1;
+}
+
 std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, index coarse_nodes, const Comm& comm,
                                                           index min_nodes_per_rank,
                                                           std::optional<index> device_min_nodes) {
@@ -133,13 +158,7 @@ std::shared_ptr<const GridHierarchy> GridHierarchy::build(const GridDims& fine, 
   h->space = launch_space();
   const bool device = launch_on_device() && !comm.distributed();
   const index host_below = !device ? 0 : device_min_nodes ? *device_min_nodes : tresca::device_min_nodes();
-  std::vector<GridDims> grids;
-  GridDims g = fine;
-  for (;;) {
-    grids.push_back(g);
-    if (g.nodes() <= coarse_nodes || (g.ex == 1 && g.ey == 1 && g.ez == 1)) break;
-    g = coarsen(g);
-  }
+  const std::vector<GridDims> grids = coarsening(fine, coarse_nodes);
   bool whole = false;  // once a level is whole, so are the coarser ones
   for (size_t l = 0; l < grids.size(); ++l) {
     Level lv;

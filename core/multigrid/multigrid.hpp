@@ -149,6 +149,20 @@ struct GridHierarchy {
                                                     std::optional<index> device_min_nodes = std::nullopt);
 };
 
+// The grids of a hierarchy from `fine`: semi-coarsened until one has at
+// most coarse_nodes nodes (GridHierarchy::build)
+std::vector<GridDims> coarsening(const GridDims& fine, index coarse_nodes = MGOptions{}.coarse_nodes);
+// The anisotropy semi-coarsening cannot remove: on the first level of
+// coarsening(fine) whose thinnest axis has one element left (a plate's
+// thickness), the largest ratio of an element's edge along an axis with
+// more than one element to that thickness; 1 where no such level is made.
+// Above about 4 the point smoother leaves errors smooth across the
+// thickness and rough along the plate, which the coarser levels, wider
+// still, do not represent: the boundary Newton system's V-cycle of K + B
+// (the contact face free) stalls on thin plates of wide elements
+// (perf/RESULTS.md §0ze).
+real unresolved_anisotropy(const GridDims& fine, index coarse_nodes = MGOptions{}.coarse_nodes);
+
 // The description of the operator a multigrid preconditions: its
 // rediscretisation on this rank's part of any grid of the hierarchy (the
 // finest included). Other materials or constrained faces plug in here;
