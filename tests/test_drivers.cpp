@@ -236,7 +236,7 @@ TEST(TrescaDriver, TakesATinyButNonzeroNumber) {
 TEST(TrescaDriver, UnitsBeyondAFloatsRangeRunTheVCyclesInDoubleAndSaySo) {
   // E = 1e40 Pa overflowed the single-precision V-cycle (exit 1,
   // inner_solver_failure, |b| printed as 0), as did loads scaled by 1e-40
-  // (RESULTS.md §0ze); the answer in u scales as 1/E
+  // (RESULTS.md §0ze); now each converges, its KKT check passed
   const char* note = "note: the multigrid V-cycles run in double precision";
   expect_run("tresca --dims 8x4x4 --quiet --E 1e40", 0, note);
   expect_run("tresca --dims 8x4x4 --quiet --load-scale 1e-40", 0, note);
