@@ -495,7 +495,7 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
     std::printf(
         "note: the Newton steps' inner solves were tightened %.3gx: steps solved with the default inner "
         "tolerance missed their accuracy when checked with a fresh S du (S is much smaller than its terms, "
-        "e.g. nu near -1)\n",
+        "e.g. nu near -1 or a thin plate)\n",
         N.inner_tightening);
   char device_peak[64] = "";
   if (R.peak_device_memory > 0)
