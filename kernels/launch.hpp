@@ -20,16 +20,17 @@
 // sweeps: the operators' stencils and diagonals, every multigrid level's
 // vectors, the Krylov vectors; it lives where the launches run.
 #pragma once
-#include "field.hpp"
-#include "types.hpp"
-
 #include <omp.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <string>
 #include <type_traits>
 #include <vector>
+
+#include "field.hpp"
+#include "types.hpp"
 
 namespace tresca {
 
@@ -270,20 +271,42 @@ inline void for_row_share(index n1, index n0, index t, index w, const Body& body
 }
 }  // namespace detail
 
+#ifdef TRESCA_OFFLOAD
+namespace detail {
+// A body for a target region, as bytes. GCC 12 maps a lambda's pointer
+// captures as zero-length array sections and attaches them: a device
+// pointer (omp_target_alloc's, not in libgomp's table) arrives as NULL and
+// a null one stops the run ("attempt to attach null pointer"), as the first
+// run on a GPU showed (an H200, RESULTS.md §0ze). Bytes travel as they are:
+// the region reads its copy of the body from them.
+template <class Body>
+struct BodyBytes {
+  static_assert(std::is_trivially_copyable<Body>::value, "a device body holds device pointers and scalars");
+  alignas(Body) unsigned char bytes[sizeof(Body)];
+};
+template <class Body>
+inline BodyBytes<Body> body_bytes(const Body& body) {
+  BodyBytes<Body> b;
+  std::memcpy(b.bytes, &body, sizeof(Body));
+  return b;
+}
+}  // namespace detail
+#endif
+
 // body(i) for every i in [0, n), independent entries vectorised across i.
 template <class Body>
 inline void for_each_entry(const char* kernel, index n, Cost per_entry, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
     const detail::DeviceLaunch launch(kernel, double(n) * per_entry);
-    // a copy of the body, mapped implicitly: its captures (device pointers,
+    // the body's bytes, mapped implicitly: its captures (device pointers,
     // scalars) travel by value (GCC 12 fails on a lambda in a map or
-    // firstprivate clause: an internal compiler error)
+    // firstprivate clause: an internal compiler error; detail::BodyBytes)
     DeviceRegion region;
-    Body b = body;
+    const detail::BodyBytes<Body> bb = detail::body_bytes(body);
     const int warps = device_warps();
 #pragma omp target teams distribute parallel for simd thread_limit(warps)
-    for (index i = 0; i < n; ++i) b(i);
+    for (index i = 0; i < n; ++i) (*reinterpret_cast<const Body*>(bb.bytes))(i);
     return;
   }
 #endif
@@ -341,10 +364,10 @@ inline void for_each_block(const char* kernel, index n, Cost work, const Body& b
   if (launch_on_device()) {
     const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
-    Body b = body;
+    const detail::BodyBytes<Body> bb = detail::body_bytes(body);
     const int warps = device_warps();
 #pragma omp target teams distribute parallel for thread_limit(warps)
-    for (index i = 0; i < n; ++i) b(i);
+    for (index i = 0; i < n; ++i) (*reinterpret_cast<const Body*>(bb.bytes))(i);
     return;
   }
 #endif
@@ -358,11 +381,11 @@ inline void for_each_block(const char* kernel, index n1, index n0, Cost work, co
   if (launch_on_device()) {  // one block per (team) thread; the body's own `omp simd` loops in its lanes
     const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
-    Body b = body;
+    const detail::BodyBytes<Body> bb = detail::body_bytes(body);
     const int warps = device_warps();
 #pragma omp target teams distribute parallel for collapse(2) thread_limit(warps)
     for (index j = 0; j < n1; ++j)
-      for (index i = 0; i < n0; ++i) b(j, i);
+      for (index i = 0; i < n0; ++i) (*reinterpret_cast<const Body*>(bb.bytes))(j, i);
     return;
   }
 #endif
@@ -388,13 +411,14 @@ inline void for_each_block_with_scratch(const char* kernel, index n2, index n1, 
     const int warps = device_warps();
     T* pool = static_cast<T*>(device_scratch(std::size_t(kScratchTeams) * warps * scratch * sizeof(T)));
     DeviceRegion region;
-    Body b = body;
+    const detail::BodyBytes<Body> bb = detail::body_bytes(body);
 #pragma omp target teams distribute parallel for collapse(3) num_teams(kScratchTeams) thread_limit(warps) \
     is_device_ptr(pool)
     for (index c = 0; c < n2; ++c)
       for (index j = 0; j < n1; ++j)
         for (index i = 0; i < n0; ++i)
-          b(c, j, i, pool + (index(omp_get_team_num()) * warps + omp_get_thread_num()) * scratch);
+          (*reinterpret_cast<const Body*>(bb.bytes))(
+              c, j, i, pool + (index(omp_get_team_num()) * warps + omp_get_thread_num()) * scratch);
     return;
   }
 #endif
@@ -430,11 +454,12 @@ inline real sum_over_blocks(const char* kernel, index n, index width, Cost per_e
   if (launch_on_device()) {
     const detail::DeviceLaunch launch(kernel, double(n) * per_entry);
     DeviceRegion region;
-    Entry e = entry;
+    const detail::BodyBytes<Entry> eb = detail::body_bytes(entry);
     const int warps = device_warps();
 #pragma omp target teams distribute map(from : part[0 : nb]) thread_limit(warps)
     for (index b = 0; b < nb; ++b) {
       const index i1 = b + 1 < nb ? (b + 1) * width : n;
+      const Entry& e = *reinterpret_cast<const Entry*>(eb.bytes);
       real s = 0;
 #pragma omp parallel for simd reduction(+ : s)
       for (index i = b * width; i < i1; ++i) s += e(i);

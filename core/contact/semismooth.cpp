@@ -663,12 +663,15 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
   if (!work.apply(S, du.data(), Sdu, inc_rtol, Edu, Edu)) return NewtonReason::inner_failure;
   r_err = std::max(r_err, accuracy);
   check_step(Sdu);
+  // (the launches' bodies take copies of members, not `this`: a body that
+  // read p through it read host memory on a GPU, RESULTS.md §0ze)
+  const index np = p;
   {  // Δλ: the known part, plus (S Δu)_z on contact nodes
     const real* known_part = L.dlambda.data();
     const std::uint8_t* status = x.status.data();
     real* dl = dlambda.data();
     for_each_entry("newton-step dlambda", p, Cost{25, 1},
-                   [=](index i) { dl[i] = known_part[i] + ((status[i] & kContact) ? Sdu[2 * p + i] : 0); });
+                   [=](index i) { dl[i] = known_part[i] + ((status[i] & kContact) ? Sdu[2 * np + i] : 0); });
   }
 
   real alpha = 1;
@@ -678,8 +681,8 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
       real *tu = trial.u.data(), *tr = trial.r.data(), *tl = trial.lambda.data();
       for_each_entry("line search trial", p, Cost{128, 14}, [=](index i) {
         for (int c = 0; c < 3; ++c) {
-          tu[c * p + i] = u[c * p + i] + a * dU[c * p + i];
-          tr[c * p + i] = r[c * p + i] + a * Sdu[c * p + i];
+          tu[c * np + i] = u[c * np + i] + a * dU[c * np + i];
+          tr[c * np + i] = r[c * np + i] + a * Sdu[c * np + i];
         }
         tl[i] = lambda[i] + a * dl[i];
       });
