@@ -277,7 +277,7 @@ namespace detail {
 // captures as zero-length array sections and attaches them: a device
 // pointer (omp_target_alloc's, not in libgomp's table) arrives as NULL and
 // a null one stops the run ("attempt to attach null pointer"), as the first
-// run on a GPU showed (an H200, RESULTS.md §0ze). Bytes travel as they are:
+// run on a GPU showed (an H200, RESULTS.md §0zf). Bytes travel as they are:
 // the region reads its copy of the body from them.
 template <class Body>
 struct BodyBytes {

@@ -664,7 +664,7 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
   r_err = std::max(r_err, accuracy);
   check_step(Sdu);
   // (the launches' bodies take copies of members, not `this`: a body that
-  // read p through it read host memory on a GPU, RESULTS.md §0ze)
+  // read p through it read host memory on a GPU, RESULTS.md §0zf)
   const index np = p;
   {  // Δλ: the known part, plus (S Δu)_z on contact nodes
     const real* known_part = L.dlambda.data();
