@@ -45,11 +45,8 @@ int main(int argc, char** argv) {
     const double t0 = wall_time();
     const Problem P = make_problem(spec);  // every rank builds the whole load
     MGOptions mo;
-    const std::string why_double = why_double_precision(spec);
-    if (!why_double.empty()) {
-      mo.precision = Precision::double_precision;
-      if (comm.rank() == 0) std::fprintf(stderr, "elastic: note: %s\n", why_double.c_str());
-    }
+    const std::string why_double = keep_vcycles_in_range(spec, mo);
+    if (!why_double.empty() && comm.rank() == 0) std::fprintf(stderr, "elastic: note: %s\n", why_double.c_str());
     const Multigrid mg(P.grid, P.interior_faces, spec.E, spec.nu, mo, comm);
     comm.barrier();
     const double t1 = wall_time();

@@ -267,12 +267,7 @@ void parse_command(const Args& a, const Comm& comm, Command& c) {
   if (a.has("--initial")) read_initial_iterate(a, c);
   newton_options_from(a, table, c.opt.newton);
   multigrid_options_from(a, c.opt.mg);
-  // (a float overflows at E = 1e40 Pa and underflows under loads of 1e-40:
-  // there the V-cycles run in double)
-  if (c.opt.mg.precision == Precision::single_precision) {
-    c.why_double = why_double_precision(c.spec);
-    if (!c.why_double.empty()) c.opt.mg.precision = Precision::double_precision;
-  }
+  c.why_double = keep_vcycles_in_range(c.spec, c.opt.mg);
   friction_from(a, table, c.opt.friction);
   c.opt.nested = !a.has("--no-nested") && !table;  // --table: the paper's cold start
   if (a.has("--coulomb-method") && !c.opt.friction.is_coulomb())

@@ -365,9 +365,10 @@ std::string apply_device(const Args& a, const Comm& comm) {
   return "gpu, " + device_description();
 }
 
-std::string why_double_precision(const ProblemSpec& s) {
+std::string keep_vcycles_in_range(const ProblemSpec& s, MGOptions& mg) {
   const ProblemScales sc = scales_of(s);
-  if (fits_single_precision(sc)) return "";
+  if (mg.precision != Precision::single_precision || fits_single_precision(sc)) return "";
+  mg.precision = Precision::double_precision;
   char text[400];
   std::snprintf(text, sizeof text,
                 "the multigrid V-cycles run in double precision: this problem's magnitudes (stiffness %.1e to "

@@ -12,6 +12,7 @@
 namespace tresca {
 
 class Comm;
+struct MGOptions;
 
 class Args {
  public:
@@ -89,9 +90,10 @@ int apply_threads(const Args& a);
 // target regions run on the host).
 std::string apply_device(const Args& a, const Comm& comm);
 std::string dims_string(const ProblemSpec& s);
-// Empty where single-precision V-cycles hold the magnitudes of s
-// (problem.hpp: fits_single_precision), else a note for the user saying
-// why the drivers run them in double (E = 1e40 Pa, loads scaled by 1e-40)
-std::string why_double_precision(const ProblemSpec& s);
+// The drivers' V-cycles in single precision only where it holds the
+// magnitudes of s (problem.hpp: fits_single_precision): elsewhere (E = 1e40
+// Pa, loads scaled by 1e-40) mg's single precision becomes double, and the
+// returned note for the user says why; empty where nothing changed
+std::string keep_vcycles_in_range(const ProblemSpec& s, MGOptions& mg);
 
 }  // namespace tresca
