@@ -11,22 +11,32 @@
 namespace tresca {
 
 namespace {
-// d_12, d_4 of the approximation step at scale s (contact_maps.hpp)
-struct NodeStep {
-  real d1, d2, d4;
-  bool stick, contact;
-};
-inline NodeStep node_step(real s, real phi, real x1, real x2, real x3, real x4, real r1, real r2, bool kink_contact) {
+// max(0, x) as std::max(real(0), x) computes it (0 where x is NaN), by
+// value: std::max binds its arguments to references, and a launch body's
+// temporaries whose address a call takes are, in GCC 12's GPU code, copies
+// on the lanes' private stack whose reads it can get wrong (the step's t and
+// d_4 read as 0: RESULTS.md §0zg; tests/check_device_code.py keeps every
+// device body off that stack).
+inline real max0(real x) { return real(0) < x ? x : real(0); }
+
+// d_12, d_4 of the approximation step at scale s (contact_maps.hpp), and
+// the node's state there
+inline void node_step(real s, real phi, real x1, real x2, real x3, real x4, real r1, real r2, bool kink_contact,
+                      real& d1, real& d2, real& d4, bool& stick, bool& contact) {
   const real z1 = x1 - r1 / s, z2 = x2 - r2 / s;
   const real nz = std::sqrt(z1 * z1 + z2 * z2);
   // t = 1 - phi / (s |z|) where positive, else 0 (no branch: where s |z| = 0
   // the quotient is inf or NaN, and max gives 0 for both)
-  const real t = std::max(real(0), 1 - phi / (s * nz));
+  const real t = max0(1 - phi / (s * nz));
   // contact where lambda - s (u_z + g) > 0, and on the kink (= 0) if asked
   const real c = x4 - s * x3;
+  d1 = t * z1;
+  d2 = t * z2;
+  d4 = max0(c);
+  stick = t == 0;
   // (the kink as a bitwise term: a choice between two comparisons is one
   // GCC 12 does not vectorise)
-  return {t * z1, t * z2, std::max(real(0), c), t == 0, bool((c > 0) | (kink_contact & (c == 0)))};
+  contact = bool((c > 0) | (kink_contact & (c == 0)));
 }
 }  // namespace
 
@@ -71,21 +81,24 @@ ResidualNorms approximation_step(index p, const ContactLaw& law, const real* sca
       const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + law.gap[i], x4 = lambda[i];
       const real r1 = r[i], r2 = r[p + i];
       const real su = has_units ? units[i] : 1, ss = has_scale ? scale[i] : 1;
-      const NodeStep paper = node_step(1, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact);
-      const NodeStep unit = node_step(su, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact);
-      const NodeStep step = node_step(ss, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact);
-      v[i] = paper.d1 - x1;
-      v[p + i] = paper.d2 - x2;
+      // the paper's step (s = 1), the units' and the scale's
+      real p1, p2, p4, u1, u2, u4, s1, s2, s4;
+      bool stick, contact, unused_stick, unused_contact;
+      node_step(1, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact, p1, p2, p4, unused_stick, unused_contact);
+      node_step(su, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact, u1, u2, u4, unused_stick, unused_contact);
+      node_step(ss, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact, s1, s2, s4, stick, contact);
+      v[i] = p1 - x1;
+      v[p + i] = p2 - x2;
       v[2 * p + i] = -(r[2 * p + i] - x4);
-      v[3 * p + i] = paper.d4 - x4;
-      w[i] = su * (unit.d1 - x1);
-      w[p + i] = su * (unit.d2 - x2);
+      v[3 * p + i] = p4 - x4;
+      w[i] = su * (u1 - x1);
+      w[p + i] = su * (u2 - x2);
       w[2 * p + i] = v[2 * p + i];
-      w[3 * p + i] = unit.d4 - x4;
-      d[i] = step.d1;
-      d[p + i] = step.d2;
-      d[2 * p + i] = step.d4;
-      status[i] = std::uint8_t((step.contact ? kContact : 0) | (step.stick ? kStick : 0));
+      w[3 * p + i] = u4 - x4;
+      d[i] = s1;
+      d[p + i] = s2;
+      d[2 * p + i] = s4;
+      status[i] = std::uint8_t((contact ? kContact : 0) | (stick ? kStick : 0));
     });
   };
   using yes = std::true_type;

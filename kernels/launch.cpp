@@ -5,14 +5,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
-
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -151,7 +151,17 @@ long long setting(const char* name, long long fallback, long long lo, long long 
 }  // namespace
 
 int device_warps() {
-  static const int warps = int(setting("TRESCA_DEVICE_WARPS", 8, 1, 32, "a warp count in 1..32"));
+  static const int warps = [] {
+    const int asked = int(setting("TRESCA_DEVICE_WARPS", kDeviceWarps, 1, 32, "a warp count in 1..32"));
+    if (asked != kDeviceWarps)
+      throw std::invalid_argument(
+          "TRESCA_DEVICE_WARPS=" + std::to_string(asked) + ": this build's device teams have " +
+          std::to_string(kDeviceWarps) +
+          " warps; the team size is a build setting (cmake -DTRESCA_DEVICE_WARPS=" + std::to_string(asked) +
+          "): read at run time it cost every launch a device "
+          "allocation (perf/RESULTS.md §0zg)");
+    return asked;
+  }();
   return warps;
 }
 
@@ -403,6 +413,13 @@ void by_host_shares(const char* kernel, std::size_t bytes, const Piece& piece) {
 }
 }  // namespace
 
+void detail::copy_between(Space to_space, void* to, Space from_space, const void* from, std::size_t bytes) {
+  DeviceRegion region(true);
+  if (omp_target_memcpy(to, from, bytes, 0, 0, device_of(to_space), device_of(from_space)) != 0)
+    throw std::runtime_error(std::string("copying ") + std::to_string(bytes) + " bytes from the " +
+                             to_string(from_space) + " to the " + to_string(to_space) + " failed");
+}
+
 void space_copy(Space to_space, void* to, Space from_space, const void* from, std::size_t bytes) {
   if (bytes == 0) return;
   if (to_space == Space::host && from_space == Space::host) {
@@ -412,12 +429,7 @@ void space_copy(Space to_space, void* to, Space from_space, const void* from, st
     return;
   }
   const long long t0 = detail::now_ns();
-  {
-    DeviceRegion region(true);
-    if (omp_target_memcpy(to, from, bytes, 0, 0, device_of(to_space), device_of(from_space)) != 0)
-      throw std::runtime_error(std::string("copying a field from the ") + to_string(from_space) + " to the " +
-                               to_string(to_space) + " failed");
-  }
+  detail::copy_between(to_space, to, from_space, from, bytes);
   const char* kernel = from_space == Space::host ? "copy host to device"
                        : to_space == Space::host ? "copy device to host"
                                                  : "copy device to device";
@@ -428,11 +440,16 @@ void space_zero(Space s, void* p, std::size_t bytes) {
   if (bytes == 0) return;
 #ifdef TRESCA_OFFLOAD
   if (s == Space::device) {
-    const detail::DeviceLaunch launch("zero (device memory)", Cost{double(bytes), 0});
-    DeviceRegion region;
-    unsigned char* q = static_cast<unsigned char*>(p);
-#pragma omp target teams distribute parallel for is_device_ptr(q) device(device())
-    for (std::size_t i = 0; i < bytes; ++i) q[i] = 0;
+    // 8-byte words (a block's start is aligned), then the bytes left
+    const index words = index(bytes / 8), n = words + index(bytes % 8);
+    std::uint64_t* w = static_cast<std::uint64_t*>(p);
+    unsigned char* tail = static_cast<unsigned char*>(p) + 8 * words;
+    detail::device_entries("zero (device memory)", n, Cost{double(bytes) / double(n), 0}, [=](index i) {
+      if (i < words)
+        w[i] = 0;
+      else
+        tail[i - words] = 0;
+    });
     return;
   }
 #endif
@@ -466,16 +483,17 @@ void field_read_on_host(Space s) {
                          " memory was read or written on the host (kernels/field.hpp)");
 }
 
-void* device_scratch(std::size_t bytes) {
-  // grown, never shrunk; the process's exit releases it
-  static void* p = nullptr;
-  static std::size_t have = 0;
-  if (bytes > have) {
-    if (p) device_release(p);
-    p = device_allocate(bytes);
-    have = bytes;
+void* device_scratch(Scratch use, std::size_t bytes) {
+  // grown, never shrunk; the process's exit releases them
+  static void* p[2] = {};
+  static std::size_t have[2] = {};
+  const int k = use == Scratch::blocks ? 0 : 1;
+  if (bytes > have[k]) {
+    if (p[k]) device_release(p[k]);
+    p[k] = device_allocate(bytes);
+    have[k] = bytes;
   }
-  return p;
+  return p[k];
 }
 
 namespace {
@@ -516,7 +534,8 @@ DeviceInfo device_info() {
 std::string device_description() {
   if (!offload_built()) return "none (built without offload)";
   const int n = omp_get_num_devices();
-  const std::string teams = ", " + std::to_string(device_warps()) + " warps a team, multigrid levels and coarser meshes under " +
+  const std::string teams = ", " + std::to_string(kDeviceWarps) +
+                            " warps a team, multigrid levels and coarser meshes under " +
                             std::to_string(device_min_nodes()) + " nodes on the host";
   if (n == 0) return "none: target regions run on the host" + teams;
   const DeviceInfo info = device_info();

@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <initializer_list>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -68,9 +69,19 @@ DeviceInfo device_info();
 // RESULTS.md §0n). A thread's registers are those of the heaviest body in
 // the kernel's device image: this file's launch.cpp and the vector kernels
 // are a shared library of their own in an offload build, an image apart
-// from the apply's (CMakeLists.txt, tresca_launch; RESULTS.md §0z). From
-// TRESCA_DEVICE_WARPS (1..32), read once; default 8, libgomp's own. Throws
-// std::invalid_argument for any other value.
+// from the apply's (CMakeLists.txt, tresca_launch; RESULTS.md §0z). A
+// build setting (CMake TRESCA_DEVICE_WARPS, 1..32; default 8, libgomp's
+// own): a thread_limit known only at run time is a firstprivate value of
+// the target region, which maps it, and every mapping allocates device
+// memory, which in GCC 12's libgomp costs a launch about 1.5 ms (RESULTS.md
+// §0zg). device_warps() is that value; it throws std::invalid_argument
+// where the environment's TRESCA_DEVICE_WARPS asks for another (or for a
+// count outside 1..32).
+#ifndef TRESCA_DEVICE_WARPS
+#define TRESCA_DEVICE_WARPS 8
+#endif
+constexpr int kDeviceWarps = TRESCA_DEVICE_WARPS;
+static_assert(kDeviceWarps >= 1 && kDeviceWarps <= 32, "TRESCA_DEVICE_WARPS: a warp count in 1..32");
 int device_warps();
 
 // In a device run, the multigrid levels (the finest aside) and the nested
@@ -125,10 +136,13 @@ class DeviceRegion {
 bool device_guarded();  // whether that guard is on
 
 // scratch for a device launch: `bytes` of device memory, kept and reused
-// from launch to launch (one launch at a time)
-void* device_scratch(std::size_t bytes);
+// from launch to launch (one launch at a time), one buffer for each use:
+// the blocks' workers' (for_each_block_with_scratch), and the partial sums
+// of sum_over_blocks
+enum class Scratch { blocks, sums };
+void* device_scratch(Scratch use, std::size_t bytes);
 // the blocks' scratch on the device: at most kScratchTeams teams of
-// device_warps() workers, each with its own slice
+// kDeviceWarps workers, each with its own slice
 constexpr int kScratchTeams = 1024;
 
 // The launches so far, by where they ran: the fork/join census of
@@ -205,6 +219,10 @@ class HostLaunch {
   Cost work_;
   long long t0_;
 };
+// bytes between the host's and the device's memory (omp_target_memcpy),
+// not counted as a copy: part of the launch that makes it (a reduction's
+// partial sums; space_copy counts the Fields' copies)
+void copy_between(Space to_space, void* to, Space from_space, const void* from, std::size_t bytes);
 // One device launch (a target region), counted and timed likewise.
 class DeviceLaunch {
  public:
@@ -272,23 +290,60 @@ inline void for_row_share(index n1, index n0, index t, index w, const Body& body
 }  // namespace detail
 
 #ifdef TRESCA_OFFLOAD
+// What a target region takes from the host: its ranges, its scratch and its
+// body (a lambda's captures: device pointers and scalars), in a variable of
+// the device image, `tresca_device_args`, sent before each launch by
+// `target update` (one small copy to the device), so that the region maps
+// nothing. Two reasons, both met on an H200 (RESULTS.md §0zf; the first
+// traced in libgomp's binary, §0zg):
+//   - a target region with any map clause, even an implicit firstprivate
+//     one, allocates device memory for the addresses of what it maps, and
+//     libgomp's nvptx plugin (GCC 12) frees its cached per-warp stacks at
+//     every allocation when they exceed 128 MiB, as they do at full
+//     occupancy (128 KiB a warp, thousands of warps): every launch then
+//     allocated about 1 GB anew and cost 1.5 ms, the whole solve's time;
+//   - GCC 12 attaches a mapped lambda's pointer captures: device pointers
+//     (omp_target_alloc's, not in libgomp's table) arrived as NULL.
+// One copy per translation unit (internal linkage), in its own device image
+// (a program's and libtresca_launch.so's are images apart, CMakeLists.txt).
 namespace detail {
-// A body for a target region, as bytes. GCC 12 maps a lambda's pointer
-// captures as zero-length array sections and attaches them: a device
-// pointer (omp_target_alloc's, not in libgomp's table) arrives as NULL and
-// a null one stops the run ("attempt to attach null pointer"), as the first
-// run on a GPU showed (an H200, RESULTS.md §0zf). Bytes travel as they are:
-// the region reads its copy of the body from them.
-template <class Body>
-struct BodyBytes {
-  static_assert(std::is_trivially_copyable<Body>::value, "a device body holds device pointers and scalars");
-  alignas(Body) unsigned char bytes[sizeof(Body)];
+constexpr std::size_t kDeviceBodyBytes = 512;
+constexpr int kDeviceArgSizes = 4;
+struct DeviceArgs {
+  index n[kDeviceArgSizes];  // the launch's sizes
+  void* pool;
+  alignas(16) unsigned char body[kDeviceBodyBytes];
 };
+}  // namespace detail
+#pragma omp declare target
+static detail::DeviceArgs tresca_device_args;
+#pragma omp end declare target
+namespace detail {
+// sends a launch's ranges, scratch and body to the device
 template <class Body>
-inline BodyBytes<Body> body_bytes(const Body& body) {
-  BodyBytes<Body> b;
-  std::memcpy(b.bytes, &body, sizeof(Body));
-  return b;
+inline void send_to_device(const Body& body, std::initializer_list<index> sizes, void* pool = nullptr) {
+  static_assert(std::is_trivially_copyable<Body>::value, "a device body holds device pointers and scalars");
+  static_assert(sizeof(Body) <= kDeviceBodyBytes, "a device body larger than kDeviceBodyBytes");
+  TRESCA_ASSERT(sizes.size() <= std::size_t(kDeviceArgSizes));
+  std::copy(sizes.begin(), sizes.end(), tresca_device_args.n);
+  tresca_device_args.pool = pool;
+  std::memcpy(tresca_device_args.body, &body, sizeof(Body));
+#pragma omp target update to(tresca_device_args)
+}
+// the body sent, in a target region
+template <class Body>
+inline const Body& sent_body() {
+  return *reinterpret_cast<const Body*>(tresca_device_args.body);
+}
+// body(i) for every i in [0, n) as one target region, across the teams'
+// threads and their lanes, wherever the launches run
+template <class Body>
+inline void device_entries(const char* kernel, index n, Cost per_entry, const Body& body) {
+  const DeviceLaunch launch(kernel, double(n) * per_entry);
+  DeviceRegion region;
+  send_to_device(body, {n});
+#pragma omp target teams distribute parallel for simd thread_limit(kDeviceWarps)
+  for (index i = 0; i < tresca_device_args.n[0]; ++i) sent_body<Body>()(i);
 }
 }  // namespace detail
 #endif
@@ -298,15 +353,7 @@ template <class Body>
 inline void for_each_entry(const char* kernel, index n, Cost per_entry, const Body& body) {
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
-    const detail::DeviceLaunch launch(kernel, double(n) * per_entry);
-    // the body's bytes, mapped implicitly: its captures (device pointers,
-    // scalars) travel by value (GCC 12 fails on a lambda in a map or
-    // firstprivate clause: an internal compiler error; detail::BodyBytes)
-    DeviceRegion region;
-    const detail::BodyBytes<Body> bb = detail::body_bytes(body);
-    const int warps = device_warps();
-#pragma omp target teams distribute parallel for simd thread_limit(warps)
-    for (index i = 0; i < n; ++i) (*reinterpret_cast<const Body*>(bb.bytes))(i);
+    detail::device_entries(kernel, n, per_entry, body);
     return;
   }
 #endif
@@ -364,10 +411,9 @@ inline void for_each_block(const char* kernel, index n, Cost work, const Body& b
   if (launch_on_device()) {
     const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
-    const detail::BodyBytes<Body> bb = detail::body_bytes(body);
-    const int warps = device_warps();
-#pragma omp target teams distribute parallel for thread_limit(warps)
-    for (index i = 0; i < n; ++i) (*reinterpret_cast<const Body*>(bb.bytes))(i);
+    detail::send_to_device(body, {n});
+#pragma omp target teams distribute parallel for thread_limit(kDeviceWarps)
+    for (index i = 0; i < tresca_device_args.n[0]; ++i) detail::sent_body<Body>()(i);
     return;
   }
 #endif
@@ -381,11 +427,13 @@ inline void for_each_block(const char* kernel, index n1, index n0, Cost work, co
   if (launch_on_device()) {  // one block per (team) thread; the body's own `omp simd` loops in its lanes
     const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
-    const detail::BodyBytes<Body> bb = detail::body_bytes(body);
-    const int warps = device_warps();
-#pragma omp target teams distribute parallel for collapse(2) thread_limit(warps)
-    for (index j = 0; j < n1; ++j)
-      for (index i = 0; i < n0; ++i) (*reinterpret_cast<const Body*>(bb.bytes))(j, i);
+    detail::send_to_device(body, {n1 * n0, n0});
+    // (the two ranges as one, as collapse(2) would: for_each_block_with_scratch)
+#pragma omp target teams distribute parallel for thread_limit(kDeviceWarps)
+    for (index k = 0; k < tresca_device_args.n[0]; ++k) {
+      const index j = k / tresca_device_args.n[1];
+      detail::sent_body<Body>()(j, k - j * tresca_device_args.n[1]);
+    }
     return;
   }
 #endif
@@ -408,17 +456,20 @@ inline void for_each_block_with_scratch(const char* kernel, index n2, index n1, 
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {  // each (team, thread) its slice of one scratch buffer
     const detail::DeviceLaunch launch(kernel, work);
-    const int warps = device_warps();
-    T* pool = static_cast<T*>(device_scratch(std::size_t(kScratchTeams) * warps * scratch * sizeof(T)));
+    void* pool = device_scratch(Scratch::blocks, std::size_t(kScratchTeams) * kDeviceWarps * scratch * sizeof(T));
     DeviceRegion region;
-    const detail::BodyBytes<Body> bb = detail::body_bytes(body);
-#pragma omp target teams distribute parallel for collapse(3) num_teams(kScratchTeams) thread_limit(warps) \
-    is_device_ptr(pool)
-    for (index c = 0; c < n2; ++c)
-      for (index j = 0; j < n1; ++j)
-        for (index i = 0; i < n0; ++i)
-          (*reinterpret_cast<const Body*>(bb.bytes))(
-              c, j, i, pool + (index(omp_get_team_num()) * warps + omp_get_thread_num()) * scratch);
+    // (the three ranges as one, as collapse(3) would: GCC 12 fails on a
+    // collapsed nest whose bounds a target region reads, an internal
+    // compiler error)
+    detail::send_to_device(body, {n2 * n1 * n0, n1, n0, scratch}, pool);
+#pragma omp target teams distribute parallel for num_teams(kScratchTeams) thread_limit(kDeviceWarps)
+    for (index k = 0; k < tresca_device_args.n[0]; ++k) {
+      const index* z = tresca_device_args.n;  // (all, n1, n0, scratch)
+      const index row = k / z[2], c = row / z[1];
+      T* mine = static_cast<T*>(tresca_device_args.pool) +
+                (index(omp_get_team_num()) * kDeviceWarps + omp_get_thread_num()) * z[3];
+      detail::sent_body<Body>()(c, row - c * z[1], k - row * z[2], mine);
+    }
     return;
   }
 #endif
@@ -453,18 +504,22 @@ inline real sum_over_blocks(const char* kernel, index n, index width, Cost per_e
 #ifdef TRESCA_OFFLOAD
   if (launch_on_device()) {
     const detail::DeviceLaunch launch(kernel, double(n) * per_entry);
-    DeviceRegion region;
-    const detail::BodyBytes<Entry> eb = detail::body_bytes(entry);
-    const int warps = device_warps();
-#pragma omp target teams distribute map(from : part[0 : nb]) thread_limit(warps)
-    for (index b = 0; b < nb; ++b) {
-      const index i1 = b + 1 < nb ? (b + 1) * width : n;
-      const Entry& e = *reinterpret_cast<const Entry*>(eb.bytes);
-      real s = 0;
+    void* sums = device_scratch(Scratch::sums, std::size_t(nb) * sizeof(real));
+    {
+      DeviceRegion region;
+      detail::send_to_device(entry, {n, width, nb}, sums);
+#pragma omp target teams distribute thread_limit(kDeviceWarps)
+      for (index b = 0; b < tresca_device_args.n[2]; ++b) {
+        const index all = tresca_device_args.n[0], w = tresca_device_args.n[1];
+        const index i1 = b + 1 < tresca_device_args.n[2] ? (b + 1) * w : all;
+        const Entry& e = detail::sent_body<Entry>();
+        real s = 0;
 #pragma omp parallel for simd reduction(+ : s)
-      for (index i = b * width; i < i1; ++i) s += e(i);
-      part[b] = s;
+        for (index i = b * w; i < i1; ++i) s += e(i);
+        static_cast<real*>(tresca_device_args.pool)[b] = s;
+      }
     }
+    detail::copy_between(Space::host, part, Space::device, sums, std::size_t(nb) * sizeof(real));
   } else
 #endif
   {

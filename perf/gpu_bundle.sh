@@ -4,6 +4,8 @@
 # test machine: ../shared/device/README.md). Run on Debian from the project
 # root:
 #   bash perf/gpu_bundle.sh [bundle-dir]          (default .gpu-bundle, git-ignored)
+#   (BUNDLE_WARPS="4 16" adds warps-4/ and warps-16/: bench_kernels and tresca
+#   built with those team sizes, for run.sh warps)
 # then, on the GPU machine, from the project root of the copy that travelled:
 #   bash .gpu-bundle/run.sh [STAGE]      (the stages: perf/gpu_run.sh's header)
 # where OUT is set, each stage's log and files also land in $OUT.
@@ -24,7 +26,7 @@ configure=(-DCMAKE_BUILD_TYPE=Release -DTRESCA_OFFLOAD=ON -DCMAKE_CXX_COMPILER=g
            -DTRESCA_MPI=OFF -DTRESCA_NATIVE=OFF -DTRESCA_ARCH=x86-64-v3)
 mkdir -p "$build"
 cmake -S . -B "$build" "${configure[@]}" > "$build/configure.log"
-cmake --build "$build" -j "$(nproc)" --target test_device bench_kernels tresca elastic roofline > "$build/build.log"
+cmake --build "$build" -j "$(nproc)" --target test_device bench_kernels tresca elastic roofline device_code_fixture > "$build/build.log"
 # bench_kernels once more with the vector kernels in the program's device
 # image (TRESCA_LAUNCH_LIBRARY=STATIC), for run.sh images
 one="$build-one-image"
@@ -33,13 +35,24 @@ cmake -S . -B "$one" "${configure[@]}" -DTRESCA_LAUNCH_LIBRARY=STATIC > "$one/co
 cmake --build "$one" -j "$(nproc)" --target bench_kernels > "$one/build.log"
 rm -rf "$out"
 mkdir -p "$out/lib"
-cp "$build"/bin/test_device "$build"/bin/bench_kernels "$build"/bin/tresca "$build"/bin/elastic "$build"/bin/roofline "$out"/
+cp "$build"/bin/test_device "$build"/bin/bench_kernels "$build"/bin/tresca "$build"/bin/elastic "$build"/bin/roofline \
+   "$build"/bin/device_code_fixture "$out"/
 cp "$build"/lib/libtresca_launch.so "$out/lib/"  # (the vector kernels' device image, CMakeLists.txt)
 mkdir -p "$out/one-image"
 cp "$one"/bin/bench_kernels "$out/one-image/"
 lib=/usr/lib/x86_64-linux-gnu
 cp -L "$lib"/libgomp.so.1 "$lib"/libgomp-plugin-nvptx.so.1 "$out/lib/"
 cp -L "$(ldconfig -p | awk '/libbenchmark\.so\./ {print $NF; exit}')" "$out/lib/"
+# the same programs with other team sizes, for run.sh warps (each a build
+# of its own: the team size is a build setting, kernels/launch.hpp)
+for w in ${BUNDLE_WARPS:-}; do
+  wb="$build-warps$w"
+  mkdir -p "$wb" "$out/warps-$w/lib"
+  cmake -S . -B "$wb" "${configure[@]}" -DTRESCA_DEVICE_WARPS="$w" > "$wb/configure.log"
+  cmake --build "$wb" -j "$(nproc)" --target bench_kernels tresca > "$wb/build.log"
+  cp "$wb"/bin/bench_kernels "$wb"/bin/tresca "$out/warps-$w/"
+  cp "$wb"/lib/libtresca_launch.so "$out/warps-$w/lib/"
+done
 cp perf/gpu_run.sh "$out/run.sh"
 cp tests/compare_runs.py "$out/"
 chmod +x "$out/run.sh"

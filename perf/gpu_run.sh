@@ -12,7 +12,9 @@
 #                   GPU, only that, and exit status 1)
 #   run.sh tests    the device tests (a run without a usable GPU fails:
 #                   Device.PresentWhereRequired; GCC 12 falls back to the
-#                   host even with OMP_TARGET_OFFLOAD=MANDATORY)
+#                   host even with OMP_TARGET_OFFLOAD=MANDATORY), after
+#                   tests/device_code_fixture.cpp, GCC 12's miscompiled
+#                   pattern (its line says WRONG on a GPU)
 #   run.sh bench    the Device* benchmarks (BENCH=regex) and roofline
 #                   --device gpu at level 13 (DeviceAxpy/1024 and
 #                   DeviceDot/1024: what one launch costs)
@@ -22,9 +24,10 @@
 #                   within 1e-10 of each column's largest, same contact and
 #                   stick sets, same Newton and Krylov iterations (issue 22)
 #   run.sh large    tresca --device gpu at levels 13, 14 and 15
-#   run.sh warps    the team size (TRESCA_DEVICE_WARPS 1, 2, 4, 8, 16): the
-#                   level-13 apply, V-cycle and vector benchmarks and a
-#                   level-12 contact solve with each (perf/offload_registers.py
+#   run.sh warps    the team size (a build setting, TRESCA_DEVICE_WARPS: the
+#                   bundle's and each warps-N/ that gpu_bundle.sh built with
+#                   BUNDLE_WARPS="N ..."): the level-13 apply, V-cycle and
+#                   vector benchmarks and a level-12 contact solve with each (perf/offload_registers.py
 #                   predicts the occupancy of each image; RESULTS.md §0n, §0z)
 #   run.sh cut      where the multigrid and the nested iteration leave the
 #                   device (TRESCA_DEVICE_MIN_NODES 0, 8192, 32768, 131072,
@@ -143,7 +146,7 @@ if [[ $stage == first ]]; then
   echo "== summary (whole logs above, and in run_first.log where OUT is set)"
   keep='^\[ +(PASSED|FAILED) +\]|_median|^== |largest difference|sets equal|iterations .* vs|same solution|DIFFERENT'
   keep+='|^(converged|not converged)|^work: .*peak|^times \[s\]|^# device|^apply y = Kx|^(apply \(float\)|dot|axpy|cg_update) +[0-9]|^V-cycle \('
-  keep+='|exit status [1-9]|error|refused'
+  keep+='|exit status [1-9]|error|refused|^fixture:'
   keep+='| (device|copy) +[0-9]+ +[0-9.]+ +([5-9]|[1-9][0-9])\.[0-9]%|^in launches:'  # (kernels of 5 % and more)
   for f in "$out"/*.log; do
     echo "-- ${f##*/}"
@@ -152,6 +155,9 @@ if [[ $stage == first ]]; then
   exit "${no_gpu:-0}"
 fi
 if [[ $stage == tests || $stage == all ]]; then
+  # the body GCC 12 miscompiles for the GPU (tests/check_device_code.py):
+  # WRONG on a GPU shows the bug the check keeps out of the kernels
+  [[ ! -x $bin/device_code_fixture ]] || "$bin/device_code_fixture" || true
   "$bin/test_device"
 fi
 if [[ $stage == bench || $stage == all ]]; then
@@ -171,10 +177,16 @@ if [[ $stage == contact || $stage == all ]]; then
   contact "${COULOMB_LEVEL:-10}" --coulomb 0.8
 fi
 if [[ $stage == warps ]]; then
-  for w in 1 2 4 8 16; do
-    echo "== TRESCA_DEVICE_WARPS=$w"
-    TRESCA_DEVICE_WARPS=$w bench "Device(Apply|ApplyFloat|VCycle)/$L/|Device(Dot|CgUpdate)/$V/"
-    TRESCA_DEVICE_WARPS=$w "$bin/tresca" --level 12 --device gpu --quiet --json "$out/warps_$w.json"
+  # the team size is a build setting (kernels/launch.hpp): the bundle's own
+  # programs, and those built with other sizes (gpu_bundle.sh BUNDLE_WARPS)
+  for b in "$bin" "$here"/warps-*; do
+    [[ -x $b/bench_kernels ]] || continue
+    lib=$b/lib  # (each build's own libtresca_launch.so)
+    [[ -d $lib ]] || lib=$here/lib
+    echo "== $b: $(LD_LIBRARY_PATH=$lib:$LD_LIBRARY_PATH "$b/tresca" --level 1 --device gpu 2>&1 | grep -o '[0-9]* warps a team' | head -1)"
+    LD_LIBRARY_PATH=$lib:$LD_LIBRARY_PATH "$b/bench_kernels" --benchmark_filter="Device(Apply|ApplyFloat|VCycle)/$L/|Device(Dot|CgUpdate)/$V/" \
+      --benchmark_repetitions=3 --benchmark_report_aggregates_only=true "${bench_args[@]}"
+    LD_LIBRARY_PATH=$lib:$LD_LIBRARY_PATH "$b/tresca" --level 12 --device gpu --quiet --json "$out/warps_${b##*/}.json"
   done
 fi
 if [[ $stage == cut ]]; then

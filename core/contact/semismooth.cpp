@@ -175,14 +175,19 @@ void subtract_known(const ReducedSystem& L, index p, const real* Sk, real* rhs) 
   });
 }
 
-// The rows of S x + H x (+ F t (S x)_z: Coulomb Newton) at node i, from sx = (S x)_i
-inline void reduced_rows(index p, index i, const real sx[3], const real* x, const ReducedSystem::View& L, real y[3]) {
-  y[0] = sx[0] + L.h[i] * x[i] + L.h[p + i] * x[p + i];
-  y[1] = sx[1] + L.h[p + i] * x[i] + L.h[2 * p + i] * x[p + i];
-  y[2] = sx[2];
+// The rows (y0, y1, y2) of S x + H x (+ F t (S x)_z: Coulomb Newton) at node
+// i, from (s0, s1, s2) = (S x)_i. Scalars in and out: a launch's body that
+// passes a local array's address on is miscompiled by GCC 12 for the GPU (its
+// lanes' private copies are written, the callee's reads and writes dropped:
+// the results were never computed, RESULTS.md §0zg; tests/check_device_code.py)
+inline void reduced_rows(index p, index i, real s0, real s1, real s2, const real* x, const ReducedSystem::View& L,
+                         real& y0, real& y1, real& y2) {
+  y0 = s0 + L.h[i] * x[i] + L.h[p + i] * x[p + i];
+  y1 = s1 + L.h[p + i] * x[i] + L.h[2 * p + i] * x[p + i];
+  y2 = s2;
   if (L.coupled) {
-    y[0] += L.coupling[i] * y[2];
-    y[1] += L.coupling[p + i] * y[2];
+    y0 += L.coupling[i] * y2;
+    y1 += L.coupling[p + i] * y2;
   }
 }
 
@@ -212,10 +217,11 @@ class ReducedNewtonOperator : public LinearOperatorWithSide {
     const index p = S_.size() / 3;
     const ReducedSystem::View L = L_.view();
     for_each_entry("newton-step operator", p, Cost{123, 12}, [=](index i) {
-      const real sx[3] = {Sx[i], Sx[p + i], Sx[2 * p + i]};
-      real yi[3];
-      reduced_rows(p, i, sx, x, L, yi);
-      for (int a = 0; a < 3; ++a) y[a * p + i] = L.free[a * p + i] ? yi[a] : 0;
+      real y0, y1, y2;
+      reduced_rows(p, i, Sx[i], Sx[p + i], Sx[2 * p + i], x, L, y0, y1, y2);
+      y[i] = L.free[i] ? y0 : 0;
+      y[p + i] = L.free[p + i] ? y1 : 0;
+      y[2 * p + i] = L.free[2 * p + i] ? y2 : 0;
     });
   }
 
@@ -729,15 +735,11 @@ void NewtonSolve::check_step(const real* Sdu) {
   const real *dU = du.data(), *Sk = L.known_product.data(), *rhs = L.rhs.data();
   const index np = p;
   const real missed = std::sqrt(S.sum(sum_over_entries("newton-step check", p, Cost{131, 20}, [=](index i) {
-    const real sx[3] = {Sdu[i] - Sk[i], Sdu[np + i] - Sk[np + i], Sdu[2 * np + i] - Sk[2 * np + i]};
-    real y[3];
-    reduced_rows(np, i, sx, dU, V, y);
-    real e = 0;
-    for (int a = 0; a < 3; ++a) {
-      const real d = V.free[a * np + i] ? y[a] - rhs[a * np + i] : 0;
-      e += d * d;
-    }
-    return e;
+    real y0, y1, y2;
+    reduced_rows(np, i, Sdu[i] - Sk[i], Sdu[np + i] - Sk[np + i], Sdu[2 * np + i] - Sk[2 * np + i], dU, V, y0, y1, y2);
+    const real d0 = V.free[i] ? y0 - rhs[i] : 0, d1 = V.free[np + i] ? y1 - rhs[np + i] : 0,
+               d2 = V.free[2 * np + i] ? y2 - rhs[2 * np + i] : 0;
+    return d0 * d0 + d1 * d1 + d2 * d2;
   })));
   // (a factor > 1 where the step left more than a tenth of r_F, else 0)
   const real factor =
