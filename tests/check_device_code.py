@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
-"""Guard against a GCC 12 miscompile of GPU code: no device body of an
-offload build may keep values on its lanes' private (SIMT) stack.
+"""Two guards on the GPU code of an offload build, read from the programs:
+no device body keeps values on its lanes' private (SIMT) stack, and no
+target region maps anything.
 
     check_device_code.py BINARY [BINARY ...]
     check_device_code.py --expect-flagged BINARY
 
+The SIMT stack.
 Found on the test machine (an H200, RESULTS.md §0zg): in a body a launch
 runs in a warp's lanes (`parallel for simd`: for_each_entry, and
 sum_over_blocks' device form), a local whose address a call takes (an
@@ -20,10 +22,21 @@ function of every image BINARY loads and reports each one that stores to
 or loads from its SIMT stack (other than the frame link every simd region
 saves). Write such bodies with scalars passed and returned by value.
 
-Exit 0 when no body uses that stack; 1 (naming them) otherwise. With
---expect-flagged, the reverse: exit 0 only if some body of BINARY is
-reported (tests/device_code_fixture.cpp, the pattern that failed, shows
-that the check still sees it with this compiler)."""
+Maps. A target region that maps anything (a map clause, an implicit map,
+a firstprivate scalar such as a thread_limit known only at run time)
+allocates device memory at every launch for the mapped addresses, and
+GCC 12's nvptx plugin then frees its cached per-warp stacks, over 1 GB at
+full occupancy, to allocate them again at the launch: 1.5 ms a launch on
+the H200 (RESULTS.md §0zf, §0zg). Launches pass what they need through the
+device image instead (kernels/launch.hpp, detail::send_to_device). Every
+call of libgomp's GOMP_target_ext in the host code (objdump) must pass 0
+as its mapnum, its third argument (%edx, x86-64).
+
+Exit 0 when no body uses that stack and no region maps; 1 (naming them)
+otherwise. With --expect-flagged, the reverse: exit 0 only if BINARY has
+both a body on the stack and a region that maps
+(tests/device_code_fixture.cpp, written with both, shows that the checks
+still see them with this compiler)."""
 import os
 import re
 import subprocess
@@ -53,6 +66,28 @@ def simt_stack_users(ptx):
     return found
 
 
+def mapping_regions(binary):
+    """the host code's calls of GOMP_target_ext, as (address, mapnum or None
+    where the code does not show a constant)"""
+    asm = subprocess.run(["objdump", "-d", "--no-show-raw-insn", binary], capture_output=True, text=True).stdout
+    lines = asm.split("\n")
+    calls = []
+    for k, line in enumerate(lines):
+        if not re.search(r"call\s.*<GOMP_target_ext@plt>", line):
+            continue
+        mapnum = None
+        for j in range(k - 1, max(0, k - 80), -1):  # the last write of %edx before the call
+            m = re.search(r"\s(xor|mov)\s+(\S+),%(e|r)dx\s*$", lines[j])
+            if m:
+                if m.group(1) == "xor" and m.group(2) in ("%edx", "%rdx"):
+                    mapnum = 0
+                elif m.group(1) == "mov" and m.group(2).startswith("$"):
+                    mapnum = int(m.group(2)[1:], 16)
+                break
+        calls.append((line.split(":")[0].strip(), mapnum))
+    return calls
+
+
 def demangled(name):
     base = name.split("$")[0]
     return subprocess.run(["c++filt", base], capture_output=True, text=True).stdout.strip()[:220]
@@ -64,26 +99,37 @@ def main():
     binaries = [a for a in args if a != "--expect-flagged"]
     if not binaries:
         sys.exit(__doc__)
-    flagged, scanned = [], 0
+    flagged, scanned, maps, regions = [], 0, [], 0
     for binary in binaries:
         for image in images(binary):
             for module in modules(image):
                 scanned += 1
                 for name, n in simt_stack_users(module):
                     flagged.append((os.path.basename(image), name, n))
+            for address, mapnum in mapping_regions(image):
+                regions += 1
+                if mapnum != 0:
+                    maps.append((os.path.basename(image), address, mapnum))
     if scanned == 0:
         sys.exit(f"no device code (PTX) in {' '.join(binaries)}: not an offload build?")
     unique = sorted(set(flagged))
     for image, name, n in unique:
         print(f"{image}: {n} accesses to the SIMT stack in {demangled(name)}")
-    print(f"{scanned} PTX modules scanned, {len(unique)} bodies on the SIMT stack")
+    for image, address, mapnum in maps:
+        what = f"maps {mapnum}" if mapnum is not None else "maps what the code does not show"
+        print(f"{image}: the target region launched at {address} {what}")
+    print(f"{scanned} PTX modules scanned, {len(unique)} bodies on the SIMT stack; "
+          f"{regions} target regions, {len(maps)} that map")
     if expect:
-        print("the fixture's body is flagged: the check sees the pattern" if unique
-              else "FAILED: the fixture's body was not flagged (the check no longer sees the pattern)")
-        sys.exit(0 if unique else 1)
+        seen = bool(unique) and bool(maps)
+        print("the fixture is flagged by both checks: they see the patterns" if seen
+              else "FAILED: the fixture was not flagged by both checks (they no longer see the patterns)")
+        sys.exit(0 if seen else 1)
     if unique:
         print("FAILED: device bodies above keep locals on the lanes' private stack (see this script's header)")
-    sys.exit(1 if unique else 0)
+    if maps:
+        print("FAILED: target regions above map (see this script's header)")
+    sys.exit(1 if unique or maps else 0)
 
 
 if __name__ == "__main__":

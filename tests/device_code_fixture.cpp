@@ -1,9 +1,11 @@
-// The pattern GCC 12 miscompiled for the GPU (tests/check_device_code.py),
-// as the Newton-step operator had it: a launch body that passes local arrays
-// on to a function and reads them back in a loop. The program exists to be
-// scanned (`check_device_code.py --expect-flagged`): its body must be
-// flagged, or the check no longer sees what it guards against. Run, it
-// says whether its host result is right (it is; the GPU's was not).
+// The two patterns tests/check_device_code.py keeps out of the GPU code:
+// a launch body that passes local arrays on to a function and reads them
+// back in a loop, which GCC 12 miscompiled for the GPU (as the Newton-step
+// operator had it), and a target region that maps a value, which costs a
+// launch 1.5 ms in GCC 12's libgomp. The program exists to be scanned
+// (`check_device_code.py --expect-flagged`): both must be flagged, or the
+// checks no longer see what they guard against. Run, it says whether its
+// first result is right (on the host it is; on a GPU it was not).
 #include <cstdio>
 #include <vector>
 
@@ -39,7 +41,10 @@ int main() {
     for (int a = 0; a < 3; ++a) y[a * p + i] = L.free[a * p + i] ? yi[a] : 0;
   });
   const std::vector<double> r = out.to_vector();
-  const bool ok = r[7] == 3.0 && r[p + 7] == 3.0 && r[2 * p + 7] == 1.0;
+  double mapped = 0;  // a region that maps a value
+#pragma omp target map(tofrom : mapped)
+  mapped = 1;
+  const bool ok = r[7] == 3.0 && r[p + 7] == 3.0 && r[2 * p + 7] == 1.0 && mapped == 1;
   std::printf("fixture: rows of node 7 = (%g, %g, %g) (3, 3, 1 expected): %s\n", r[7], r[p + 7], r[2 * p + 7],
               ok ? "ok" : "WRONG");
   return ok ? 0 : 1;

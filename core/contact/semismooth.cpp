@@ -176,10 +176,11 @@ void subtract_known(const ReducedSystem& L, index p, const real* Sk, real* rhs) 
 }
 
 // The rows (y0, y1, y2) of S x + H x (+ F t (S x)_z: Coulomb Newton) at node
-// i, from (s0, s1, s2) = (S x)_i. Scalars in and out: a launch's body that
-// passes a local array's address on is miscompiled by GCC 12 for the GPU (its
-// lanes' private copies are written, the callee's reads and writes dropped:
-// the results were never computed, RESULTS.md §0zg; tests/check_device_code.py)
+// i, from (s0, s1, s2) = (S x)_i. No arrays: a launch's body that passed
+// local arrays to it was miscompiled by GCC 12 for the GPU (the arrays went to
+// its lanes' private stack, and the callee's reads and writes were dropped:
+// the rows were never computed, RESULTS.md §0zg). These scalar references
+// are inlined away first, as tests/check_device_code.py verifies.
 inline void reduced_rows(index p, index i, real s0, real s1, real s2, const real* x, const ReducedSystem::View& L,
                          real& y0, real& y1, real& y2) {
   y0 = s0 + L.h[i] * x[i] + L.h[p + i] * x[p + i];
