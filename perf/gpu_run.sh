@@ -7,14 +7,15 @@
 #                   of them within FIRST_BUDGET seconds (default 420): tests,
 #                   the level-13 apply, V-cycle and vector benchmarks,
 #                   contact (levels 8 and 12, Coulomb), level 14 on the GPU,
-#                   roofline, level 15; then a summary of the lines that
+#                   roofline, level 15, why; then a summary of the lines that
 #                   answer issue 22's bars (where the device tests find no
 #                   GPU, only that, and exit status 1)
 #   run.sh tests    the device tests (a run without a usable GPU fails:
 #                   Device.PresentWhereRequired; GCC 12 falls back to the
 #                   host even with OMP_TARGET_OFFLOAD=MANDATORY), after
 #                   tests/device_code_fixture.cpp, GCC 12's miscompiled
-#                   pattern (its line says WRONG on a GPU)
+#                   pattern (its line says WRONG on a GPU); a device test
+#                   that fails on a GPU runs again under compute-sanitizer
 #   run.sh bench    the Device* benchmarks (BENCH=regex) and roofline
 #                   --device gpu at level 13 (DeviceAxpy/1024 and
 #                   DeviceDot/1024: what one launch costs)
@@ -139,6 +140,7 @@ if [[ $stage == first ]]; then
   step 90 30 4-large large LARGE_LEVELS="${FIRST_LARGE:-14}"
   step 60 20 5-roofline bench BENCH=none
   step 150 60 6-largest large LARGE_LEVELS="${FIRST_LARGEST:-15}"
+  step 60 20 7-why why
   # the lines that answer issue 22's bars, step by step: tests passed, the
   # benchmarks' medians, each solve's verdict, work and times, GPU against
   # CPU, the roofline's device triad and kernels, each GPU solve's kernels
@@ -158,7 +160,21 @@ if [[ $stage == tests || $stage == all ]]; then
   # the body GCC 12 miscompiles for the GPU (tests/check_device_code.py):
   # WRONG on a GPU shows the bug the check keeps out of the kernels
   [[ ! -x $bin/device_code_fixture ]] || "$bin/device_code_fixture" || true
-  "$bin/test_device"
+  set +e
+  "$bin/test_device" 2>&1 | tee "$out/test_device.log"
+  rc=${PIPESTATUS[0]}
+  set -e
+  # a device test that fails on a GPU again under compute-sanitizer (memcheck:
+  # the first illegal accesses and the kernels that made them), where it is
+  sanitizer=$(command -v compute-sanitizer || ls /usr/local/cuda/bin/compute-sanitizer 2>/dev/null || true)
+  failed=$(sed -nE 's/^\[  FAILED  \] (Device[A-Za-z]*\.[A-Za-z]+) \(.*/\1/p' "$out/test_device.log" |
+           grep -v PresentWhereRequired | paste -sd: || true)
+  if [[ -n $failed && -n $sanitizer ]] && nvidia-smi > /dev/null 2>&1; then
+    echo "== compute-sanitizer --tool memcheck on $failed"
+    timeout -k 5 ${SANITIZER_SECONDS:-90} "$sanitizer" --tool memcheck --print-limit 12 "$bin/test_device" \
+      --gtest_filter="$failed" 2>&1 | grep -vE '^\[ +(RUN|OK) ' | head -80 || true
+  fi
+  ((rc == 0)) || exit "$rc"
 fi
 if [[ $stage == bench || $stage == all ]]; then
   [[ ${BENCH:-} == none ]] || bench "${BENCH:-Device}"
