@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Two guards on the GPU code of an offload build, read from the programs:
-no device body keeps values on its lanes' private (SIMT) stack, and no
-target region maps anything.
+"""Guards on the GPU code of an offload build, read from the programs: no
+device body keeps values on its lanes' private (SIMT) stack, no target
+region maps anything, and the host's and the device's tables of variables
+agree.
 
     check_device_code.py BINARY [BINARY ...]
     check_device_code.py --expect-flagged BINARY
@@ -32,8 +33,15 @@ device image instead (kernels/launch.hpp, detail::send_to_device). Every
 call of libgomp's GOMP_target_ext in the host code (objdump) must pass 0
 as its mapnum, its third argument (%edx, x86-64).
 
-Exit 0 when no body uses that stack and no region maps; 1 (naming them)
-otherwise. With --expect-flagged, the reverse: exit 0 only if BINARY has
+The variables' tables. Each translation unit's launch arguments are a
+`declare target` variable of its own (kernels/launch.hpp): the host's
+offload table (`.gnu.offload_vars`, an address and a size a variable) and
+the device image's (mkoffload's list of their PTX names) must have as many
+entries, or libgomp refuses the image when it loads it on a GPU ("Cannot
+map target functions or variables"), which the host fallback never does.
+
+Exit 0 when no body uses that stack, no region maps and the tables agree;
+1 (naming what fails) otherwise. With --expect-flagged, the reverse: exit 0 only if BINARY has
 both a body on the stack and a region that maps
 (tests/device_code_fixture.cpp, written with both, shows that the checks
 still see them with this compiler)."""
@@ -88,6 +96,19 @@ def mapping_regions(binary):
     return calls
 
 
+def variable_tables(binary):
+    """(the host offload table's variables, the device image's): the host's
+    from the section's size, the device's as the PTX variables whose names
+    also stand as strings of their own (mkoffload's table)"""
+    head = subprocess.run(["objdump", "-h", binary], capture_output=True, text=True).stdout
+    m = re.search(r"\s\.gnu\.offload_vars\s+([0-9a-f]+)", head)
+    host = int(m.group(1), 16) // 16 if m else 0
+    data = open(binary, "rb").read()
+    names = set(re.findall(rb"// BEGIN VAR DEF: (\S+)", data))
+    device = sum(1 for n in names if b"\0" + n + b"\0" in data)
+    return host, device
+
+
 def demangled(name):
     base = name.split("$")[0]
     return subprocess.run(["c++filt", base], capture_output=True, text=True).stdout.strip()[:220]
@@ -99,7 +120,7 @@ def main():
     binaries = [a for a in args if a != "--expect-flagged"]
     if not binaries:
         sys.exit(__doc__)
-    flagged, scanned, maps, regions = [], 0, [], 0
+    flagged, scanned, maps, regions, tables = [], 0, [], 0, []
     for binary in binaries:
         for image in images(binary):
             for module in modules(image):
@@ -110,6 +131,9 @@ def main():
                 regions += 1
                 if mapnum != 0:
                     maps.append((os.path.basename(image), address, mapnum))
+            host, device = variable_tables(image)
+            if host != device:
+                tables.append((os.path.basename(image), host, device))
     if scanned == 0:
         sys.exit(f"no device code (PTX) in {' '.join(binaries)}: not an offload build?")
     unique = sorted(set(flagged))
@@ -118,8 +142,10 @@ def main():
     for image, address, mapnum in maps:
         what = f"maps {mapnum}" if mapnum is not None else "maps what the code does not show"
         print(f"{image}: the target region launched at {address} {what}")
+    for image, host, device in tables:
+        print(f"{image}: {host} variables in the host's offload table, {device} in the device image's")
     print(f"{scanned} PTX modules scanned, {len(unique)} bodies on the SIMT stack; "
-          f"{regions} target regions, {len(maps)} that map")
+          f"{regions} target regions, {len(maps)} that map; {len(tables)} images whose variable tables differ")
     if expect:
         seen = bool(unique) and bool(maps)
         print("the fixture is flagged by both checks: they see the patterns" if seen
@@ -129,7 +155,9 @@ def main():
         print("FAILED: device bodies above keep locals on the lanes' private stack (see this script's header)")
     if maps:
         print("FAILED: target regions above map (see this script's header)")
-    sys.exit(1 if unique or maps else 0)
+    if tables:
+        print("FAILED: the offload tables above differ: libgomp would refuse the image on a GPU")
+    sys.exit(1 if unique or maps or tables else 0)
 
 
 if __name__ == "__main__":
