@@ -204,7 +204,24 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
 #pragma omp simd
                      for (index i = i0; i < i1; ++i) {
                        T acc0 = 0, acc1 = 0, acc2 = 0;
-                       for (const StencilGroupT<T>* q = q0; q != q1; ++q) {
+                       // three groups a pass, their loads independent: a
+                       // GPU lane keeps three in flight where a group a pass
+                       // waited on each load in turn (the sums' order is
+                       // the same)
+                       const StencilGroupT<T>* q = q0;
+                       for (; q1 - q >= 3; q += 3) {
+                         const T v0 = xr[i + q[0].off], v1 = xr[i + q[1].off], v2 = xr[i + q[2].off];
+                         acc0 += q[0].c[0] * v0;
+                         acc1 += q[0].c[1] * v0;
+                         acc2 += q[0].c[2] * v0;
+                         acc0 += q[1].c[0] * v1;
+                         acc1 += q[1].c[1] * v1;
+                         acc2 += q[1].c[2] * v1;
+                         acc0 += q[2].c[0] * v2;
+                         acc1 += q[2].c[1] * v2;
+                         acc2 += q[2].c[2] * v2;
+                       }
+                       for (; q != q1; ++q) {
                          const T v = xr[i + q->off];
                          acc0 += q->c[0] * v;
                          acc1 += q->c[1] * v;
