@@ -427,13 +427,10 @@ inline void for_each_block(const char* kernel, index n1, index n0, Cost work, co
   if (launch_on_device()) {  // one block per (team) thread; the body's own `omp simd` loops in its lanes
     const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
-    detail::send_to_device(body, {n1 * n0, n0});
-    // (the two ranges as one, as collapse(2) would: for_each_block_with_scratch)
-#pragma omp target teams distribute parallel for thread_limit(kDeviceWarps)
-    for (index k = 0; k < tresca_device_args.n[0]; ++k) {
-      const index j = k / tresca_device_args.n[1];
-      detail::sent_body<Body>()(j, k - j * tresca_device_args.n[1]);
-    }
+    detail::send_to_device(body, {n1, n0});
+#pragma omp target teams distribute parallel for collapse(2) thread_limit(kDeviceWarps)
+    for (index j = 0; j < tresca_device_args.n[0]; ++j)
+      for (index i = 0; i < tresca_device_args.n[1]; ++i) detail::sent_body<Body>()(j, i);
     return;
   }
 #endif
@@ -458,18 +455,16 @@ inline void for_each_block_with_scratch(const char* kernel, index n2, index n1, 
     const detail::DeviceLaunch launch(kernel, work);
     void* pool = device_scratch(Scratch::blocks, std::size_t(kScratchTeams) * kDeviceWarps * scratch * sizeof(T));
     DeviceRegion region;
-    // (the three ranges as one, as collapse(3) would: GCC 12 fails on a
-    // collapsed nest whose bounds a target region reads, an internal
-    // compiler error)
-    detail::send_to_device(body, {n2 * n1 * n0, n1, n0, scratch}, pool);
-#pragma omp target teams distribute parallel for num_teams(kScratchTeams) thread_limit(kDeviceWarps)
-    for (index k = 0; k < tresca_device_args.n[0]; ++k) {
-      const index* z = tresca_device_args.n;  // (all, n1, n0, scratch)
-      const index row = k / z[2], c = row / z[1];
-      T* mine = static_cast<T*>(tresca_device_args.pool) +
-                (index(omp_get_team_num()) * kDeviceWarps + omp_get_thread_num()) * z[3];
-      detail::sent_body<Body>()(c, row - c * z[1], k - row * z[2], mine);
-    }
+    // (the sizes, then each worker's slice of the pool: `scratch` entries)
+    detail::send_to_device(body, {n2, n1, n0, scratch}, pool);
+#pragma omp target teams distribute parallel for collapse(3) num_teams(kScratchTeams) thread_limit(kDeviceWarps)
+    for (index c = 0; c < tresca_device_args.n[0]; ++c)
+      for (index j = 0; j < tresca_device_args.n[1]; ++j)
+        for (index i = 0; i < tresca_device_args.n[2]; ++i)
+          detail::sent_body<Body>()(c, j, i,
+                                    static_cast<T*>(tresca_device_args.pool) +
+                                        (index(omp_get_team_num()) * kDeviceWarps + omp_get_thread_num()) *
+                                            tresca_device_args.n[3]);
     return;
   }
 #endif
