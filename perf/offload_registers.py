@@ -29,7 +29,7 @@ script adds one probe kernel per outlined body (`..$_omp_fn$N`), which calls
 it directly, and reports the probes.
 
 What it means on the GPU. libgomp (plugin-nvptx.c) starts a kernel with
-teams of W warps (TRESCA_DEVICE_WARPS, 8 by default) and as many teams as
+teams of W warps (the build's TRESCA_DEVICE_WARPS, 8 by default) and as many teams as
 its estimate of what is resident at once: floor(R / (registers x 32 x W))
 a multiprocessor, R = 65,536 registers an SM on sm_70 to sm_90. An SM holds
 at most 64 warps; a memory-bound kernel needs many of them to keep enough
@@ -124,7 +124,7 @@ def report(path, arch, warps, kernels, rows):
     worst = max(kernels)
     print(f"{path}: {len(kernels)} kernels, {len(rows)} outlined bodies, linked for {arch}")
     print(f"registers of every kernel as linked: {min(kernels)}..{worst}")
-    print("warps a team (TRESCA_DEVICE_WARPS) -> libgomp's teams an SM, warps an SM (of 64), what the SM holds:")
+    print("warps a team (the build's TRESCA_DEVICE_WARPS) -> libgomp's teams an SM, warps an SM (of 64), what the SM holds:")
     granted = -(-worst // 8) * 8  # registers a thread as the SM grants them (in steps of 256 a warp)
     for w in sorted({1, 2, 4, 8, 16, warps}):
         w = min(w, 32, 65536 // (granted * 32))  # libgomp caps a team at the kernel's largest block
@@ -132,7 +132,7 @@ def report(path, arch, warps, kernels, rows):
         # the hardware's: registers granted per warp in units of 256, at most 32 teams and 64 warps an SM
         held = min(32, 65536 // (granted * 32 * w), 64 // w)
         note = "" if teams <= held else f"  (holds {held}: the last teams wait for a second round)"
-        mark = " <- TRESCA_DEVICE_WARPS now" if w == warps else ""
+        mark = " <- this build" if w == warps else ""
         print(f"  {w:2d} -> {teams:2d} team(s), {teams * w:2d} warps ({100.0 * teams * w / 64:4.1f} %){note}{mark}")
     print("registers of each body (called directly):")
     for rg, n in rows:
@@ -144,7 +144,7 @@ def main():
     ap.add_argument("binary")
     ap.add_argument("--arch", default="sm_90", help="GPU to link for (sm_90: H100)")
     ap.add_argument("--warps", type=int, default=int(os.environ.get("TRESCA_DEVICE_WARPS", "8")),
-                    help="warps a team (TRESCA_DEVICE_WARPS; libgomp's default 8)")
+                    help="warps a team (the build's TRESCA_DEVICE_WARPS; libgomp's default 8)")
     ap.add_argument("--fail-above", type=int, default=0,
                     help="exit 1 if the kernels of any image use more registers than this")
     ap.add_argument("--limit", action="append", default=[], metavar="IMAGE=N",
