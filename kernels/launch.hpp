@@ -299,9 +299,10 @@ inline void for_row_share(index n1, index n0, index t, index w, const Body& body
 //   - a target region with any map clause, even an implicit firstprivate
 //     one, allocates device memory for the addresses of what it maps, and
 //     libgomp's nvptx plugin (GCC 12) frees its cached per-warp stacks at
-//     every allocation when they exceed 128 MiB, as they do at full
-//     occupancy (128 KiB a warp, thousands of warps): every launch then
-//     allocated about 1 GB anew and cost 1.5 ms, the whole solve's time;
+//     every allocation when they exceed 128 MiB, as they do (128 KiB a
+//     warp, thousands of warps: 0.14 GB for the program's kernels at 8
+//     warps an SM, 0.4 GB for the vector kernels'): every launch then
+//     allocated them anew and cost 1.5 ms, the whole solve's time;
 //   - GCC 12 attaches a mapped lambda's pointer captures: device pointers
 //     (omp_target_alloc's, not in libgomp's table) arrived as NULL.
 // One copy per translation unit (internal linkage), in its own device image

@@ -26,8 +26,8 @@ saves). Write such bodies with scalars passed and returned by value.
 Maps. A target region that maps anything (a map clause, an implicit map,
 a firstprivate scalar such as a thread_limit known only at run time)
 allocates device memory at every launch for the mapped addresses, and
-GCC 12's nvptx plugin then frees its cached per-warp stacks, over 1 GB at
-full occupancy, to allocate them again at the launch: 1.5 ms a launch on
+GCC 12's nvptx plugin then frees its cached per-warp stacks (128 KiB a
+warp; 0.14 to 0.4 GB on an H200) to allocate them again at the launch: 1.5 ms a launch on
 the H200 (RESULTS.md §0zf, §0zg). Launches pass what they need through the
 device image instead (kernels/launch.hpp, detail::send_to_device). Every
 call of libgomp's GOMP_target_ext in the host code (objdump) must pass 0
