@@ -19,24 +19,19 @@ namespace {
 // device body off that stack).
 inline real max0(real x) { return real(0) < x ? x : real(0); }
 
-// d_12, d_4 of the approximation step at scale s (contact_maps.hpp), and
-// the node's state there
-inline void node_step(real s, real phi, real x1, real x2, real x3, real x4, real r1, real r2, bool kink_contact,
-                      real& d1, real& d2, real& d4, bool& stick, bool& contact) {
-  const real z1 = x1 - r1 / s, z2 = x2 - r2 / s;
-  const real nz = std::sqrt(z1 * z1 + z2 * z2);
-  // t = 1 - phi / (s |z|) where positive, else 0 (no branch: where s |z| = 0
-  // the quotient is inf or NaN, and max gives 0 for both)
-  const real t = max0(1 - phi / (s * nz));
-  // contact where lambda - s (u_z + g) > 0, and on the kink (= 0) if asked
-  const real c = x4 - s * x3;
-  d1 = t * z1;
-  d2 = t * z2;
-  d4 = max0(c);
-  stick = t == 0;
+// The approximation step at scale s (contact_maps.hpp) scales z = x_12 -
+// r_12 / s by t = max(0, 1 - phi / (s |z|)): d_12 = t z, the node sticks
+// where t = 0 (no branch: where s |z| = 0 the quotient is inf or NaN, and
+// max0 gives 0 for both). Its d_4 = max(0, c) and its contact (c > 0, and
+// c = 0 on the kink if asked) come from c = lambda - s (u_z + g). Each a
+// scalar returned by value: no local of a device body has its address taken.
+inline real step_factor(real s, real phi, real z1, real z2) {
+  return max0(1 - phi / (s * std::sqrt(z1 * z1 + z2 * z2)));
+}
+inline bool in_contact(real c, bool kink_contact) {
   // (the kink as a bitwise term: a choice between two comparisons is one
   // GCC 12 does not vectorise)
-  contact = bool((c > 0) | (kink_contact & (c == 0)));
+  return bool((c > 0) | (kink_contact & (c == 0)));
 }
 }  // namespace
 
@@ -81,24 +76,24 @@ ResidualNorms approximation_step(index p, const ContactLaw& law, const real* sca
       const real x1 = u[i], x2 = u[p + i], x3 = u[2 * p + i] + law.gap[i], x4 = lambda[i];
       const real r1 = r[i], r2 = r[p + i];
       const real su = has_units ? units[i] : 1, ss = has_scale ? scale[i] : 1;
-      // the paper's step (s = 1), the units' and the scale's
-      real p1, p2, p4, u1, u2, u4, s1, s2, s4;
-      bool stick, contact, unused_stick, unused_contact;
-      node_step(1, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact, p1, p2, p4, unused_stick, unused_contact);
-      node_step(su, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact, u1, u2, u4, unused_stick, unused_contact);
-      node_step(ss, law.phi[i], x1, x2, x3, x4, r1, r2, law.kink_contact, s1, s2, s4, stick, contact);
-      v[i] = p1 - x1;
-      v[p + i] = p2 - x2;
+      // the paper's step (s = 1), the units' (su) and the scale's (ss)
+      const real pz1 = x1 - r1 / 1, pz2 = x2 - r2 / 1, uz1 = x1 - r1 / su, uz2 = x2 - r2 / su;
+      const real sz1 = x1 - r1 / ss, sz2 = x2 - r2 / ss, phi = law.phi[i];
+      const real tp = step_factor(1, phi, pz1, pz2), tu = step_factor(su, phi, uz1, uz2);
+      const real ts = step_factor(ss, phi, sz1, sz2);
+      const real cp = x4 - 1 * x3, cu = x4 - su * x3, cs = x4 - ss * x3;
+      v[i] = tp * pz1 - x1;
+      v[p + i] = tp * pz2 - x2;
       v[2 * p + i] = -(r[2 * p + i] - x4);
-      v[3 * p + i] = p4 - x4;
-      w[i] = su * (u1 - x1);
-      w[p + i] = su * (u2 - x2);
+      v[3 * p + i] = max0(cp) - x4;
+      w[i] = su * (tu * uz1 - x1);
+      w[p + i] = su * (tu * uz2 - x2);
       w[2 * p + i] = v[2 * p + i];
-      w[3 * p + i] = u4 - x4;
-      d[i] = s1;
-      d[p + i] = s2;
-      d[2 * p + i] = s4;
-      status[i] = std::uint8_t((contact ? kContact : 0) | (stick ? kStick : 0));
+      w[3 * p + i] = max0(cu) - x4;
+      d[i] = ts * sz1;
+      d[p + i] = ts * sz2;
+      d[2 * p + i] = max0(cs);
+      status[i] = std::uint8_t((in_contact(cs, law.kink_contact) ? kContact : 0) | (ts == 0 ? kStick : 0));
     });
   };
   using yes = std::true_type;
