@@ -485,9 +485,9 @@ void field_read_on_host(Space s) {
 
 void* device_scratch(Scratch use, std::size_t bytes) {
   // grown, never shrunk; the process's exit releases them
-  static void* p[2] = {};
+  static void* p[2] = {};  // (by Scratch: blocks, sums)
   static std::size_t have[2] = {};
-  const int k = use == Scratch::blocks ? 0 : 1;
+  const int k = int(use);
   if (bytes > have[k]) {
     if (p[k]) device_release(p[k]);
     p[k] = device_allocate(bytes);

@@ -197,12 +197,13 @@ if [[ $stage == warps ]]; then
   # programs, and those built with other sizes (gpu_bundle.sh BUNDLE_WARPS)
   for b in "$bin" "$here"/warps-*; do
     [[ -x $b/bench_kernels ]] || continue
-    lib=$b/lib  # (each build's own libtresca_launch.so)
-    [[ -d $lib ]] || lib=$here/lib
-    echo "== $b: $(LD_LIBRARY_PATH=$lib:$LD_LIBRARY_PATH "$b/tresca" --level 1 --device gpu 2>&1 | grep -o '[0-9]* warps a team' | head -1)"
-    LD_LIBRARY_PATH=$lib:$LD_LIBRARY_PATH "$b/bench_kernels" --benchmark_filter="Device(Apply|ApplyFloat|VCycle)/$L/|Device(Dot|CgUpdate)/$V/" \
-      --benchmark_repetitions=3 --benchmark_report_aggregates_only=true "${bench_args[@]}"
-    LD_LIBRARY_PATH=$lib:$LD_LIBRARY_PATH "$b/tresca" --level 12 --device gpu --quiet --json "$out/warps_${b##*/}.json"
+    (  # each build with its own libtresca_launch.so (the bundle's is already on the path)
+      [[ ! -d $b/lib ]] || export LD_LIBRARY_PATH="$b/lib:$LD_LIBRARY_PATH"
+      echo "== $b: $("$b/tresca" --level 1 --device gpu 2>&1 | grep -o '[0-9]* warps a team' | head -1)"
+      "$b/bench_kernels" --benchmark_filter="Device(Apply|ApplyFloat|VCycle)/$L/|Device(Dot|CgUpdate)/$V/" \
+        --benchmark_repetitions=3 --benchmark_report_aggregates_only=true "${bench_args[@]}"
+      "$b/tresca" --level 12 --device gpu --quiet --json "$out/warps_${b##*/}.json"
+    )
   done
 fi
 if [[ $stage == cut ]]; then
