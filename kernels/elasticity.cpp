@@ -195,8 +195,12 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
   const index nz = rows.z_end - rows.z_begin, nyr = rows.y_end - rows.y_begin;
   const double nodes = double(nx) * double(nz) * double(nyr);
   const char* name = precision_name<T>("apply", "apply (float)");  // (the banded apply's device form)
-  with_kind(out, [&](auto kind) {
+  // P groups a pass (device_apply_groups(), launch.hpp): a lane issues the
+  // loads of P groups before their multiply-adds, in one block of code that
+  // ptxas may schedule as a whole (the sums' order stays the groups')
+  auto sweep = [&](auto kind, auto pass) {
     constexpr OutKind K = decltype(kind)::value;
+    constexpr int P = decltype(pass)::value;
     for_each_block(name, nz, nyr, nodes * in_precision<T>(apply_cost(out)), [=](index jz, index jy) {
       sweep_row<K>(k, nx, ny, N, z0 + jz, y0 + jy, x, out,
                    [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
@@ -204,22 +208,15 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
 #pragma omp simd
                      for (index i = i0; i < i1; ++i) {
                        T acc0 = 0, acc1 = 0, acc2 = 0;
-                       // three groups a pass, their loads independent: a
-                       // GPU lane keeps three in flight where a group a pass
-                       // waited on each load in turn (the sums' order is
-                       // the same)
                        const StencilGroupT<T>* q = q0;
-                       for (; q1 - q >= 3; q += 3) {
-                         const T v0 = xr[i + q[0].off], v1 = xr[i + q[1].off], v2 = xr[i + q[2].off];
-                         acc0 += q[0].c[0] * v0;
-                         acc1 += q[0].c[1] * v0;
-                         acc2 += q[0].c[2] * v0;
-                         acc0 += q[1].c[0] * v1;
-                         acc1 += q[1].c[1] * v1;
-                         acc2 += q[1].c[2] * v1;
-                         acc0 += q[2].c[0] * v2;
-                         acc1 += q[2].c[1] * v2;
-                         acc2 += q[2].c[2] * v2;
+                       for (; q1 - q >= P; q += P) {
+#pragma GCC unroll 9
+                         for (int g = 0; g < P; ++g) {
+                           const T v = xr[i + q[g].off];
+                           acc0 += q[g].c[0] * v;
+                           acc1 += q[g].c[1] * v;
+                           acc2 += q[g].c[2] * v;
+                         }
                        }
                        for (; q != q1; ++q) {
                          const T v = xr[i + q->off];
@@ -233,8 +230,13 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
                      }
                    });
     });
+  };
+  with_kind(out, [&](auto kind) {
+    if (device_apply_groups() == 3) return sweep(kind, std::integral_constant<int, 3>{});
+    sweep(kind, std::integral_constant<int, 9>{});
   });
 }
+
 template void elasticity_apply_rows<double>(const StencilView<double>&, const double*, const ApplyOut<double>&,
                                             const RowBlock&);
 template void elasticity_apply_rows<float>(const StencilView<float>&, const float*, const ApplyOut<float>&,

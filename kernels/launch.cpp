@@ -128,9 +128,11 @@ LaunchCounts launch_counts() {
 void set_launch_on_device(bool on) {
   if (on && !offload_built())
     throw std::invalid_argument("this build has no device backend (configure with -DTRESCA_OFFLOAD=ON)");
-  if (on) {  // a bad TRESCA_DEVICE_WARPS or _MIN_NODES stops here, before any launch
+  if (on) {  // a bad TRESCA_DEVICE_* setting stops here, before any launch
     device_warps();
     device_min_nodes();
+    device_apply_groups();
+    device_rows_interleaved();
   }
   on_device = on;
 }
@@ -169,6 +171,20 @@ index device_min_nodes() {
   static const index nodes = index(setting("TRESCA_DEVICE_MIN_NODES", 32768, 0,
                                            std::numeric_limits<long long>::max(), "a node count >= 0"));
   return nodes;
+}
+
+int device_apply_groups() {
+  static const int groups = [] {
+    const int g = int(setting("TRESCA_DEVICE_GROUPS", 9, 3, 9, "3 or 9"));
+    if (g != 3 && g != 9) throw std::invalid_argument("TRESCA_DEVICE_GROUPS=" + std::to_string(g) + " must be 3 or 9");
+    return g;
+  }();
+  return groups;
+}
+
+bool device_rows_interleaved() {
+  static const bool on = setting("TRESCA_DEVICE_INTERLEAVE", 1, 0, 1, "0 or 1") == 1;
+  return on;
 }
 
 namespace {
@@ -536,7 +552,9 @@ std::string device_description() {
   const int n = omp_get_num_devices();
   const std::string teams = ", " + std::to_string(kDeviceWarps) +
                             " warps a team, multigrid levels and coarser meshes under " +
-                            std::to_string(device_min_nodes()) + " nodes on the host";
+                            std::to_string(device_min_nodes()) + " nodes on the host, the apply " +
+                            std::to_string(device_apply_groups()) + " groups a pass, rows " +
+                            (device_rows_interleaved() ? "interleaved" : "in runs");
   if (n == 0) return "none: target regions run on the host" + teams;
   const DeviceInfo info = device_info();
   char what[320] = "";

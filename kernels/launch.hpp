@@ -95,6 +95,24 @@ int device_warps();
 // only; default 32768. Throws std::invalid_argument for any other value.
 index device_min_nodes();
 
+// Two choices in the device form of the stencil apply, open at run time as
+// an A/B for the test machine until it has measured them (perf/RESULTS.md
+// §0zh); both change only the order in which work is done, not the order
+// of any sum's terms: the same answers to rounding (the host fallback's
+// compiled code differs in the last bits of a few entries near zero). Read
+// once; std::invalid_argument for any other value.
+//  - device_apply_groups(): stencil groups a lane loads at once before it
+//    multiplies (TRESCA_DEVICE_GROUPS, 3 or 9; default 9): more loads in
+//    flight a lane, more registers (perf/offload_registers.py);
+//  - device_rows_interleaved(): how a team's warps share its rows in a
+//    launch over a plane's rows (for_each_block over n1 x n0 blocks;
+//    TRESCA_DEVICE_INTERLEAVE, 0 or 1; default 1): 0, each warp a
+//    contiguous run of the team's rows (OpenMP's static schedule); 1, the
+//    warps take consecutive rows in turn, so that at any time they sweep
+//    neighbouring rows whose inputs overlap in the multiprocessor's cache.
+int device_apply_groups();
+bool device_rows_interleaved();
+
 // Launches (and new Fields) are the host's inside this scope, and where
 // they were before after it: for builders that fill Fields entry by entry
 // and then move what they made to space_before() (build_elasticity_stencil,
@@ -429,9 +447,15 @@ inline void for_each_block(const char* kernel, index n1, index n0, Cost work, co
     const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
     detail::send_to_device(body, {n1, n0});
+    if (device_rows_interleaved()) {
+#pragma omp target teams distribute parallel for collapse(2) thread_limit(kDeviceWarps) schedule(static, 1)
+      for (index j = 0; j < tresca_device_args.n[0]; ++j)
+        for (index i = 0; i < tresca_device_args.n[1]; ++i) detail::sent_body<Body>()(j, i);
+    } else {
 #pragma omp target teams distribute parallel for collapse(2) thread_limit(kDeviceWarps)
-    for (index j = 0; j < tresca_device_args.n[0]; ++j)
-      for (index i = 0; i < tresca_device_args.n[1]; ++i) detail::sent_body<Body>()(j, i);
+      for (index j = 0; j < tresca_device_args.n[0]; ++j)
+        for (index i = 0; i < tresca_device_args.n[1]; ++i) detail::sent_body<Body>()(j, i);
+    }
     return;
   }
 #endif

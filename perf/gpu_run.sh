@@ -7,7 +7,7 @@
 #                   of them within FIRST_BUDGET seconds (default 420): tests,
 #                   the level-13 apply, V-cycle and vector benchmarks,
 #                   contact (levels 8 and 12, Coulomb), level 14 on the GPU,
-#                   roofline, level 15, why; then a summary of the lines that
+#                   the apply's forms, roofline, level 15, why; then a summary of the lines that
 #                   answer issue 22's bars (where the device tests find no
 #                   GPU, only that, and exit status 1)
 #   run.sh tests    the device tests (a run without a usable GPU fails:
@@ -25,6 +25,10 @@
 #                   within 1e-10 of each column's largest, same contact and
 #                   stick sets, same Newton and Krylov iterations (issue 22)
 #   run.sh large    tresca --device gpu at levels 13, 14 and 15
+#   run.sh apply    the device apply's forms (kernels/launch.hpp:
+#                   TRESCA_DEVICE_GROUPS 3 or 9, TRESCA_DEVICE_INTERLEAVE 0
+#                   or 1) in alternating rounds: the level-13 apply in
+#                   double and float and the V-cycle (RESULTS.md §0zh)
 #   run.sh warps    the team size (a build setting, TRESCA_DEVICE_WARPS: the
 #                   bundle's and each warps-N/ that gpu_bundle.sh built with
 #                   BUNDLE_WARPS="N ..."): the level-13 apply, V-cycle and
@@ -64,7 +68,7 @@ bin=${TRESCA_BIN:-$here}
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export OMP_TARGET_OFFLOAD=${OMP_TARGET_OFFLOAD:-MANDATORY} TRESCA_REQUIRE_DEVICE=${TRESCA_REQUIRE_DEVICE:-1}
 stage=${1:-all}
-stages="first tests bench elastic contact large warps cut images why all"
+stages="first tests bench elastic contact large apply warps cut images why all"
 if [[ " $stages " != *" $stage "* ]]; then
   echo "run.sh: unknown stage '$stage' (${stages// /, })" >&2
   exit 2
@@ -77,7 +81,7 @@ base=${TMPDIR:-/tmp}/tresca-gpu-run
 out=$base/$stage  # the stage's CSV and JSON files (and first's logs)
 # a stage run by hand starts afresh, `first` with all of its steps' folders
 # (a step keeps what an earlier step of the same stage wrote: 4-large's
-# level 14 beside 6-largest's level 15)
+# level 14 beside 7-largest's level 15)
 if [[ -z ${RUN_SH_NESTED:-} ]]; then
   if [[ $stage == first ]]; then rm -rf "$base"; else rm -rf "$out"; fi
 fi
@@ -138,9 +142,10 @@ if [[ $stage == first ]]; then
   step 120 30 2-bench bench BENCH="Device(Apply|ApplyFloat|VCycle|RestrictProlong)/$L/|Device(Dot|Axpy|CgUpdate)/$V/|Device(Axpy|Dot)/1024/" NO_ROOFLINE=1
   step 150 60 3-contact contact
   step 90 30 4-large large LARGE_LEVELS="${FIRST_LARGE:-14}"
-  step 60 20 5-roofline bench BENCH=none
-  step 150 60 6-largest large LARGE_LEVELS="${FIRST_LARGEST:-15}"
-  step 60 20 7-why why
+  step 90 40 5-apply apply APPLY_ROUNDS=1
+  step 60 20 6-roofline bench BENCH=none
+  step 150 60 7-largest large LARGE_LEVELS="${FIRST_LARGEST:-15}"
+  step 60 20 8-why why
   # the lines that answer issue 22's bars, step by step: tests passed, the
   # benchmarks' medians, each solve's verdict, work and times, GPU against
   # CPU, the roofline's device triad and kernels, each GPU solve's kernels
@@ -223,12 +228,22 @@ if [[ $stage == images ]]; then
     done
   done
 fi
+if [[ $stage == apply ]]; then
+  for round in $(seq "${APPLY_ROUNDS:-2}"); do
+    for form in "9 1" "3 0" "9 0" "3 1"; do
+      read -r groups interleave <<< "$form"
+      echo "== apply: TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_INTERLEAVE=$interleave (round $round)"
+      TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_INTERLEAVE=$interleave \
+        bench "Device(Apply|ApplyFloat|VCycle)/$L/"
+    done
+  done
+fi
 if [[ $stage == why ]]; then
   filter='Device(Apply|ApplyFloat)/12/|Device(Axpy|Dot|CgUpdate)/16777216/'
   echo "== launches as libgomp makes them (count, kernel, geometry)"
   GOMP_DEBUG=1 "$bin/bench_kernels" --benchmark_filter="$filter" --benchmark_min_time=0.01 2>&1 |
     sed -nE 's/.*kernel ([^:]*): launch (.*)/\1 \2/p' | sort | uniq -c | sort -rn | head -30
-  ncu=$(command -v ncu || ls /opt/nvidia/nsight-compute/*/ncu 2>/dev/null | head -1 || true)
+  ncu=$(command -v ncu || ls /usr/local/cuda/bin/ncu /opt/nvidia/nsight-compute/*/ncu 2>/dev/null | head -1 || true)
   if [[ -z $ncu ]]; then
     echo "no ncu (Nsight Compute): no kernel reports"
   else
@@ -236,8 +251,9 @@ if [[ $stage == why ]]; then
       echo "== ncu: the first kernel whose mangled name matches $k"
       "$ncu" --clock-control none --kernel-name-base mangled --kernel-name "regex:$k" --launch-skip 2 --launch-count 1 \
         --section SpeedOfLight --section Occupancy --section LaunchStats --section MemoryWorkloadAnalysis \
+        --section WarpStateStats --section SchedulerStats \
         "$bin/bench_kernels" --benchmark_filter="$filter" --benchmark_min_time=0.01 2>&1 |
-        grep -vE '^(Device|-----|Benchmark|Run on|CPU Caches|  L[123]|Load Average|\*\*\*)' | head -80
+        grep -vE '^(Device|-----|Benchmark|Run on|CPU Caches|  L[123]|Load Average|\*\*\*)' | head -120
     done
   fi
 fi
