@@ -47,8 +47,9 @@ void set_launch_on_device(bool on);  // throws std::invalid_argument if the buil
 bool offload_built();                // whether this build has TRESCA_OFFLOAD
 // "device 0 of 1 (OpenMP offload: NVIDIA H100 80GB HBM3, 85.0 GB), 8 warps
 // a team, multigrid levels and coarser meshes under 32768 nodes on the
-// host", "none: target regions run on the host, 8 warps a team, ..." or
-// "none (built without offload)"
+// host, the apply 9 groups a pass, rows interleaved", "none: target
+// regions run on the host, 8 warps a team, ..." or "none (built without
+// offload)"
 std::string device_description();
 // The GPU's name and memory ("NVIDIA H100 80GB HBM3", 85e9 bytes), asked of
 // the CUDA driver that libgomp's nvptx plugin runs on (libcuda.so.1, opened
