@@ -133,6 +133,7 @@ void set_launch_on_device(bool on) {
     device_min_nodes();
     device_apply_groups();
     device_rows_interleaved();
+    device_warp_sums();
   }
   on_device = on;
 }
@@ -184,6 +185,11 @@ int device_apply_groups() {
 
 bool device_rows_interleaved() {
   static const bool on = setting("TRESCA_DEVICE_INTERLEAVE", 1, 0, 1, "0 or 1") == 1;
+  return on;
+}
+
+bool device_warp_sums() {
+  static const bool on = setting("TRESCA_DEVICE_WARP_SUMS", 1, 0, 1, "0 or 1") == 1;
   return on;
 }
 
@@ -554,7 +560,8 @@ std::string device_description() {
                             " warps a team, multigrid levels and coarser meshes under " +
                             std::to_string(device_min_nodes()) + " nodes on the host, the apply " +
                             std::to_string(device_apply_groups()) + " groups a pass, rows " +
-                            (device_rows_interleaved() ? "interleaved" : "in runs");
+                            (device_rows_interleaved() ? "interleaved" : "in runs") + ", sums a block a " +
+                            (device_warp_sums() ? "warp" : "team");
   if (n == 0) return "none: target regions run on the host" + teams;
   const DeviceInfo info = device_info();
   char what[320] = "";

@@ -47,9 +47,9 @@ void set_launch_on_device(bool on);  // throws std::invalid_argument if the buil
 bool offload_built();                // whether this build has TRESCA_OFFLOAD
 // "device 0 of 1 (OpenMP offload: NVIDIA H100 80GB HBM3, 85.0 GB), 8 warps
 // a team, multigrid levels and coarser meshes under 32768 nodes on the
-// host, the apply 9 groups a pass, rows interleaved", "none: target
-// regions run on the host, 8 warps a team, ..." or "none (built without
-// offload)"
+// host, the apply 9 groups a pass, rows interleaved, sums a block a warp",
+// "none: target regions run on the host, 8 warps a team, ..." or "none
+// (built without offload)"
 std::string device_description();
 // The GPU's name and memory ("NVIDIA H100 80GB HBM3", 85e9 bytes), asked of
 // the CUDA driver that libgomp's nvptx plugin runs on (libcuda.so.1, opened
@@ -113,6 +113,13 @@ index device_min_nodes();
 //    neighbouring rows whose inputs overlap in the multiprocessor's cache.
 int device_apply_groups();
 bool device_rows_interleaved();
+// A third such choice, in the device form of the deterministic sums
+// (sum_over_blocks: dot products, the fused CG updates): a block of 4096
+// entries summed by one warp across its lanes (TRESCA_DEVICE_WARP_SUMS=1,
+// the default), or by a team, which opens a parallel region for each block
+// and combines its warps' sums (0). Each block's sum is fixed by the
+// choice, whatever the number of teams; the two differ in rounding.
+bool device_warp_sums();
 
 // Launches (and new Fields) are the host's inside this scope, and where
 // they were before after it: for builders that fill Fields entry by entry
@@ -507,8 +514,10 @@ inline void for_each_block_with_scratch(const char* kernel, index n2, index n1, 
 // the result is bitwise the same for any number of workers. Each caller's
 // block is a loop over plain pointers (the CPU's explicit vectors,
 // simd.hpp). entry(i) is the same sum's term of one entry, the device's
-// form: a team per block, its entries across the team's threads and lanes
-// (one GPU thread walking a block of 4096 would read memory uncoalesced).
+// form, in one of two ways (device_warp_sums()): a warp per block, its
+// entries across the warp's lanes, or a team per block, its entries across
+// the team's warps and lanes (a parallel region a block). Either reads
+// memory coalesced, where one lane walking a block of 4096 would not.
 template <class Block, class Entry>
 inline real sum_over_blocks(const char* kernel, index n, index width, Cost per_entry, const Block& block,
                             const Entry& entry) {
@@ -529,15 +538,28 @@ inline real sum_over_blocks(const char* kernel, index n, index width, Cost per_e
     {
       DeviceRegion region;
       detail::send_to_device(entry, {n, width, nb}, sums);
+      if (device_warp_sums()) {  // a warp a block, its entries across the lanes
+#pragma omp target teams distribute parallel for thread_limit(kDeviceWarps)
+        for (index b = 0; b < tresca_device_args.n[2]; ++b) {
+          const index all = tresca_device_args.n[0], w = tresca_device_args.n[1];
+          const index i1 = b + 1 < tresca_device_args.n[2] ? (b + 1) * w : all;
+          const Entry& e = detail::sent_body<Entry>();
+          real s = 0;
+#pragma omp simd reduction(+ : s)
+          for (index i = b * w; i < i1; ++i) s += e(i);
+          static_cast<real*>(tresca_device_args.pool)[b] = s;
+        }
+      } else {  // a team a block, its entries across the team's warps and lanes
 #pragma omp target teams distribute thread_limit(kDeviceWarps)
-      for (index b = 0; b < tresca_device_args.n[2]; ++b) {
-        const index all = tresca_device_args.n[0], w = tresca_device_args.n[1];
-        const index i1 = b + 1 < tresca_device_args.n[2] ? (b + 1) * w : all;
-        const Entry& e = detail::sent_body<Entry>();
-        real s = 0;
+        for (index b = 0; b < tresca_device_args.n[2]; ++b) {
+          const index all = tresca_device_args.n[0], w = tresca_device_args.n[1];
+          const index i1 = b + 1 < tresca_device_args.n[2] ? (b + 1) * w : all;
+          const Entry& e = detail::sent_body<Entry>();
+          real s = 0;
 #pragma omp parallel for simd reduction(+ : s)
-        for (index i = b * w; i < i1; ++i) s += e(i);
-        static_cast<real*>(tresca_device_args.pool)[b] = s;
+          for (index i = b * w; i < i1; ++i) s += e(i);
+          static_cast<real*>(tresca_device_args.pool)[b] = s;
+        }
       }
     }
     detail::copy_between(Space::host, part, Space::device, sums, std::size_t(nb) * sizeof(real));

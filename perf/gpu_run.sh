@@ -7,7 +7,7 @@
 #                   of them within FIRST_BUDGET seconds (default 420): tests,
 #                   the level-13 apply, V-cycle and vector benchmarks,
 #                   contact (levels 8 and 12, Coulomb), level 14 on the GPU,
-#                   the apply's forms, roofline, level 15, why; then a summary of the lines that
+#                   the kernels' forms, roofline, level 15, why; then a summary of the lines that
 #                   answer issue 22's bars (where the device tests find no
 #                   GPU, only that, and exit status 1)
 #   run.sh tests    the device tests (a run without a usable GPU fails:
@@ -25,10 +25,12 @@
 #                   within 1e-10 of each column's largest, same contact and
 #                   stick sets, same Newton and Krylov iterations (issue 22)
 #   run.sh large    tresca --device gpu at levels 13, 14 and 15
-#   run.sh apply    the device apply's forms (kernels/launch.hpp:
-#                   TRESCA_DEVICE_GROUPS 3 or 9, TRESCA_DEVICE_INTERLEAVE 0
-#                   or 1) in alternating rounds: the level-13 apply in
-#                   double and float and the V-cycle (RESULTS.md §0zh)
+#   run.sh forms    the device kernels' forms (kernels/launch.hpp), in
+#                   alternating rounds: the level-13 apply in double and
+#                   float and the V-cycle under TRESCA_DEVICE_GROUPS 3 or 9
+#                   and TRESCA_DEVICE_INTERLEAVE 0 or 1; the dot and the CG
+#                   update at 2^27 entries under TRESCA_DEVICE_WARP_SUMS 1
+#                   or 0 (RESULTS.md §0zh)
 #   run.sh warps    the team size (a build setting, TRESCA_DEVICE_WARPS: the
 #                   bundle's and each warps-N/ that gpu_bundle.sh built with
 #                   BUNDLE_WARPS="N ..."): the level-13 apply, V-cycle and
@@ -68,7 +70,7 @@ bin=${TRESCA_BIN:-$here}
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export OMP_TARGET_OFFLOAD=${OMP_TARGET_OFFLOAD:-MANDATORY} TRESCA_REQUIRE_DEVICE=${TRESCA_REQUIRE_DEVICE:-1}
 stage=${1:-all}
-stages="first tests bench elastic contact large apply warps cut images why all"
+stages="first tests bench elastic contact large forms warps cut images why all"
 if [[ " $stages " != *" $stage "* ]]; then
   echo "run.sh: unknown stage '$stage' (${stages// /, })" >&2
   exit 2
@@ -142,7 +144,7 @@ if [[ $stage == first ]]; then
   step 120 30 2-bench bench BENCH="Device(Apply|ApplyFloat|VCycle|RestrictProlong)/$L/|Device(Dot|Axpy|CgUpdate)/$V/|Device(Axpy|Dot)/1024/" NO_ROOFLINE=1
   step 150 60 3-contact contact
   step 90 30 4-large large LARGE_LEVELS="${FIRST_LARGE:-14}"
-  step 90 40 5-apply apply APPLY_ROUNDS=1
+  step 100 40 5-forms forms FORMS_ROUNDS=1
   step 60 20 6-roofline bench BENCH=none
   step 150 60 7-largest large LARGE_LEVELS="${FIRST_LARGEST:-15}"
   step 60 20 8-why why
@@ -228,13 +230,17 @@ if [[ $stage == images ]]; then
     done
   done
 fi
-if [[ $stage == apply ]]; then
-  for round in $(seq "${APPLY_ROUNDS:-2}"); do
+if [[ $stage == forms ]]; then
+  for round in $(seq "${FORMS_ROUNDS:-2}"); do
     for form in "9 1" "3 0" "9 0" "3 1"; do
       read -r groups interleave <<< "$form"
-      echo "== apply: TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_INTERLEAVE=$interleave (round $round)"
+      echo "== forms: TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_INTERLEAVE=$interleave (round $round)"
       TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_INTERLEAVE=$interleave \
         bench "Device(Apply|ApplyFloat|VCycle)/$L/"
+    done
+    for sums in 1 0; do
+      echo "== forms: TRESCA_DEVICE_WARP_SUMS=$sums (round $round)"
+      TRESCA_DEVICE_WARP_SUMS=$sums bench "Device(Dot|CgUpdate)/$V/"
     done
   done
 fi
