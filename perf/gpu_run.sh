@@ -15,7 +15,9 @@
 #                   host even with OMP_TARGET_OFFLOAD=MANDATORY), after
 #                   tests/device_code_fixture.cpp, GCC 12's miscompiled
 #                   pattern (its line says WRONG on a GPU); a device test
-#                   that fails on a GPU runs again under compute-sanitizer
+#                   that fails on a GPU runs again under compute-sanitizer,
+#                   and with the kernels' earlier forms (where it passes
+#                   so, `first` runs its other steps with those)
 #   run.sh bench    the Device* benchmarks (BENCH=regex) and roofline
 #                   --device gpu at level 13 (DeviceAxpy/1024 and
 #                   DeviceDot/1024: what one launch costs)
@@ -99,6 +101,9 @@ if [[ -z ${RUN_SH_NESTED:-} ]]; then
   echo "# run.sh $stage, $(date -u '+%F %H:%M UTC'); $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) CPUs"
   nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader 2>/dev/null || echo "no nvidia-smi"
 fi
+# the device kernels' forms before §0zh (kernels/launch.hpp): the fallback
+# of `first` where the defaults fail a device test that these pass
+earlier_forms="TRESCA_DEVICE_GROUPS=3 TRESCA_DEVICE_INTERLEAVE=0 TRESCA_DEVICE_WARP_SUMS=0"
 bench() {  # a benchmark filter
   "$bin/bench_kernels" --benchmark_filter="$1" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
     "${bench_args[@]}"
@@ -141,6 +146,11 @@ if [[ $stage == first ]]; then
     echo "== first: no usable GPU (Device.PresentWhereRequired failed): the other steps are not run"
     deadline=$SECONDS no_gpu=1
   fi
+  if [[ -f $base/tests/earlier_forms_pass ]]; then
+    echo "== first: the default forms fail device tests that the earlier forms pass: the other steps run with $earlier_forms"
+    # shellcheck disable=SC2086 # (three assignments)
+    export $earlier_forms
+  fi
   step 120 30 2-bench bench BENCH="Device(Apply|ApplyFloat|VCycle|RestrictProlong)/$L/|Device(Dot|Axpy|CgUpdate)/$V/|Device(Axpy|Dot)/1024/" NO_ROOFLINE=1
   step 150 60 3-contact contact
   step 90 30 4-large large LARGE_LEVELS="${FIRST_LARGE:-14}"
@@ -180,6 +190,19 @@ if [[ $stage == tests || $stage == all ]]; then
     echo "== compute-sanitizer --tool memcheck on $failed"
     timeout -k 5 ${SANITIZER_SECONDS:-90} "$sanitizer" --tool memcheck --print-limit 12 "$bin/test_device" \
       --gtest_filter="$failed" 2>&1 | grep -vE '^\[ +(RUN|OK) ' | head -80 || true
+  fi
+  # the same tests with the kernels' earlier forms (RESULTS.md §0zh): where
+  # they pass so, `first` runs its other steps with those forms
+  if [[ -n $failed ]]; then
+    echo "== the failing tests again with the earlier forms: $earlier_forms"
+    # shellcheck disable=SC2086 # (three assignments)
+    env $earlier_forms "$bin/test_device" --gtest_filter="$failed" > "$out/earlier_forms.log" 2>&1 && earlier=0 ||
+      earlier=$?
+    grep -E '^\[ +(PASSED|FAILED) +\]' "$out/earlier_forms.log" || true
+    if ((earlier == 0)); then
+      touch "$out/earlier_forms_pass"
+      echo "== they pass with the earlier forms: a new form is at fault"
+    fi
   fi
   ((rc == 0)) || exit "$rc"
 fi
