@@ -195,45 +195,75 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
   const index nz = rows.z_end - rows.z_begin, nyr = rows.y_end - rows.y_begin;
   const double nodes = double(nx) * double(nz) * double(nyr);
   const char* name = precision_name<T>("apply", "apply (float)");  // (the banded apply's device form)
-  // P groups a pass (device_apply_groups(), launch.hpp): a lane issues the
-  // loads of P groups before their multiply-adds, in one block of code that
-  // ptxas may schedule as a whole (the sums' order stays the groups')
-  auto sweep = [&](auto kind, auto pass) {
+  // Two choices of form (launch.hpp), neither of which changes the order
+  // of a node's sum, which takes its groups as they are stored:
+  //  - P groups a pass (device_apply_groups()): a lane issues the loads of
+  //    P groups before their multiply-adds, in one block of code that ptxas
+  //    may schedule as a whole;
+  //  - U nodes a lane (device_lane_nodes()): a lane computes U nodes of the
+  //    run at once, S apart (for each of them the warp's lanes read
+  //    neighbouring entries), and loads each group's offset and
+  //    coefficients once for the U: U times the independent loads in
+  //    flight, a U-th of the group loads. A run shorter than U warps (the
+  //    one-node runs at a row's ends) is swept a node a lane; where U*S
+  //    passes the run's end, a lane computes its first node again and
+  //    stores nothing for the others.
+  auto sweep = [&](auto kind, auto pass, auto lane) {
     constexpr OutKind K = decltype(kind)::value;
-    constexpr int P = decltype(pass)::value;
+    constexpr int P = decltype(pass)::value, U = decltype(lane)::value;
     for_each_block(name, nz, nyr, nodes * in_precision<T>(apply_cost(out)), [=](index jz, index jy) {
       sweep_row<K>(k, nx, ny, N, z0 + jz, y0 + jy, x, out,
                    [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
                      const StencilGroupT<T>*q0 = k.groups + f[0], *q1 = k.groups + f[7];
+                     auto nodes_a_lane = [&](auto width) {
+                       constexpr int W = decltype(width)::value;
+                       const index S = (i1 - i0 + W - 1) / W;
 #pragma omp simd
-                     for (index i = i0; i < i1; ++i) {
-                       T acc0 = 0, acc1 = 0, acc2 = 0;
-                       const StencilGroupT<T>* q = q0;
-                       for (; q1 - q >= P; q += P) {
-#pragma GCC unroll 9
-                         for (int g = 0; g < P; ++g) {
-                           const T v = xr[i + q[g].off];
-                           acc0 += q[g].c[0] * v;
-                           acc1 += q[g].c[1] * v;
-                           acc2 += q[g].c[2] * v;
+                       for (index j = 0; j < S; ++j) {
+                         index at[W];
+                         T acc[W][3];
+#pragma GCC unroll 4
+                         for (int u = 0; u < W; ++u) {
+                           at[u] = i0 + j + u * S < i1 ? i0 + j + u * S : i0 + j;
+                           acc[u][0] = acc[u][1] = acc[u][2] = 0;
                          }
+                         auto add = [&](const StencilGroupT<T>& q) {
+#pragma GCC unroll 4
+                           for (int u = 0; u < W; ++u) {
+                             const T v = xr[at[u] + q.off];
+                             acc[u][0] += q.c[0] * v;
+                             acc[u][1] += q.c[1] * v;
+                             acc[u][2] += q.c[2] * v;
+                           }
+                         };
+                         const StencilGroupT<T>* q = q0;
+                         for (; q1 - q >= P; q += P) {
+#pragma GCC unroll 9
+                           for (int g = 0; g < P; ++g) add(q[g]);
+                         }
+                         for (; q != q1; ++q) add(*q);
+#pragma GCC unroll 4
+                         for (int u = 0; u < W; ++u)
+                           if (u == 0 || i0 + j + u * S < i1) {
+                             put<K>(out, x, row + at[u], acc[u][0]);
+                             put<K>(out, x, N + row + at[u], acc[u][1]);
+                             put<K>(out, x, 2 * N + row + at[u], acc[u][2]);
+                           }
                        }
-                       for (; q != q1; ++q) {
-                         const T v = xr[i + q->off];
-                         acc0 += q->c[0] * v;
-                         acc1 += q->c[1] * v;
-                         acc2 += q->c[2] * v;
-                       }
-                       put<K>(out, x, row + i, acc0);
-                       put<K>(out, x, N + row + i, acc1);
-                       put<K>(out, x, 2 * N + row + i, acc2);
-                     }
+                     };
+                     if (U > 1 && i1 - i0 >= index(32) * U) return nodes_a_lane(lane);
+                     nodes_a_lane(std::integral_constant<int, 1>{});
                    });
     });
   };
+  using std::integral_constant;
   with_kind(out, [&](auto kind) {
-    if (device_apply_groups() == 3) return sweep(kind, std::integral_constant<int, 3>{});
-    sweep(kind, std::integral_constant<int, 9>{});
+    auto with_groups = [&](auto lane) {
+      if (device_apply_groups() == 3) return sweep(kind, integral_constant<int, 3>{}, lane);
+      sweep(kind, integral_constant<int, 9>{}, lane);
+    };
+    if (device_lane_nodes() == 4) return with_groups(integral_constant<int, 4>{});
+    with_groups(integral_constant<int, 1>{});
   });
 }
 

@@ -132,6 +132,7 @@ void set_launch_on_device(bool on) {
     device_warps();
     device_min_nodes();
     device_apply_groups();
+    device_lane_nodes();
     device_rows_interleaved();
     device_warp_sums();
   }
@@ -181,6 +182,15 @@ int device_apply_groups() {
     return g;
   }();
   return groups;
+}
+
+int device_lane_nodes() {
+  static const int nodes = [] {
+    const int u = int(setting("TRESCA_DEVICE_LANE_NODES", 4, 1, 4, "1 or 4"));
+    if (u != 1 && u != 4) throw std::invalid_argument("TRESCA_DEVICE_LANE_NODES=" + std::to_string(u) + " must be 1 or 4");
+    return u;
+  }();
+  return nodes;
 }
 
 bool device_rows_interleaved() {
@@ -559,7 +569,9 @@ std::string device_description() {
   const std::string teams = ", " + std::to_string(kDeviceWarps) +
                             " warps a team, multigrid levels and coarser meshes under " +
                             std::to_string(device_min_nodes()) + " nodes on the host, the apply " +
-                            std::to_string(device_apply_groups()) + " groups a pass, rows " +
+                            std::to_string(device_apply_groups()) + " groups a pass and " +
+                            std::to_string(device_lane_nodes()) + (device_lane_nodes() == 1 ? " node" : " nodes") +
+                            " a lane, rows " +
                             (device_rows_interleaved() ? "interleaved" : "in runs") + ", sums a block a " +
                             (device_warp_sums() ? "warp" : "team");
   if (n == 0) return "none: target regions run on the host" + teams;

@@ -96,15 +96,19 @@ int device_warps();
 // only; default 32768. Throws std::invalid_argument for any other value.
 index device_min_nodes();
 
-// Two choices in the device form of the stencil apply, open at run time as
-// an A/B for the test machine until it has measured them (perf/RESULTS.md
-// §0zh); both change only the order in which work is done, not the order
-// of any sum's terms: the same answers to rounding (the host fallback's
-// compiled code differs in the last bits of a few entries near zero). Read
-// once; std::invalid_argument for any other value.
+// Three choices in the device form of the stencil apply, open at run time
+// as an A/B for the test machine until it has measured them (perf/RESULTS.md
+// §0zh, §0zi); each changes only the order in which work is done, not the
+// order of any sum's terms: the same answers to rounding (the host
+// fallback's compiled code differs in the last bits of a few entries near
+// zero). Read once; std::invalid_argument for any other value.
 //  - device_apply_groups(): stencil groups a lane loads at once before it
 //    multiplies (TRESCA_DEVICE_GROUPS, 3 or 9; default 9): more loads in
 //    flight a lane, more registers (perf/offload_registers.py);
+//  - device_lane_nodes(): nodes of a run a lane computes at once
+//    (TRESCA_DEVICE_LANE_NODES, 1 or 4; default 4): with 4, each group's
+//    offset and coefficients are loaded once for 4 nodes, and 4 times the
+//    independent loads are in flight (runs of 128 nodes and more);
 //  - device_rows_interleaved(): how a team's warps share its rows in a
 //    launch over a plane's rows (for_each_block over n1 x n0 blocks;
 //    TRESCA_DEVICE_INTERLEAVE, 0 or 1; default 1): 0, each warp a
@@ -112,6 +116,7 @@ index device_min_nodes();
 //    warps take consecutive rows in turn, so that at any time they sweep
 //    neighbouring rows whose inputs overlap in the multiprocessor's cache.
 int device_apply_groups();
+int device_lane_nodes();
 bool device_rows_interleaved();
 // A third such choice, in the device form of the deterministic sums
 // (sum_over_blocks: dot products, the fused CG updates): a block of 4096

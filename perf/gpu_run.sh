@@ -29,10 +29,11 @@
 #   run.sh large    tresca --device gpu at levels 13, 14 and 15
 #   run.sh forms    the device kernels' forms (kernels/launch.hpp), in
 #                   alternating rounds: the level-13 apply in double and
-#                   float and the V-cycle under TRESCA_DEVICE_GROUPS 3 or 9
-#                   and TRESCA_DEVICE_INTERLEAVE 0 or 1; the dot and the CG
-#                   update at 2^27 entries under TRESCA_DEVICE_WARP_SUMS 1
-#                   or 0 (RESULTS.md §0zh)
+#                   float and the V-cycle under five of the forms that
+#                   TRESCA_DEVICE_GROUPS (3, 9), TRESCA_DEVICE_LANE_NODES
+#                   (1, 4) and TRESCA_DEVICE_INTERLEAVE (0, 1) make; the dot
+#                   and the CG update at 2^27 entries under
+#                   TRESCA_DEVICE_WARP_SUMS 1 or 0 (RESULTS.md §0zh, §0zi)
 #   run.sh warps    the team size (a build setting, TRESCA_DEVICE_WARPS: the
 #                   bundle's and each warps-N/ that gpu_bundle.sh built with
 #                   BUNDLE_WARPS="N ..."): the level-13 apply, V-cycle and
@@ -103,7 +104,7 @@ if [[ -z ${RUN_SH_NESTED:-} ]]; then
 fi
 # the device kernels' forms before §0zh (kernels/launch.hpp): the fallback
 # of `first` where the defaults fail a device test that these pass
-earlier_forms="TRESCA_DEVICE_GROUPS=3 TRESCA_DEVICE_INTERLEAVE=0 TRESCA_DEVICE_WARP_SUMS=0"
+earlier_forms="TRESCA_DEVICE_GROUPS=3 TRESCA_DEVICE_LANE_NODES=1 TRESCA_DEVICE_INTERLEAVE=0 TRESCA_DEVICE_WARP_SUMS=0"
 bench() {  # a benchmark filter
   "$bin/bench_kernels" --benchmark_filter="$1" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
     "${bench_args[@]}"
@@ -154,7 +155,7 @@ if [[ $stage == first ]]; then
   step 120 30 2-bench bench BENCH="Device(Apply|ApplyFloat|VCycle|RestrictProlong)/$L/|Device(Dot|Axpy|CgUpdate)/$V/|Device(Axpy|Dot)/1024/" NO_ROOFLINE=1
   step 150 60 3-contact contact
   step 90 30 4-large large LARGE_LEVELS="${FIRST_LARGE:-14}"
-  step 100 40 5-forms forms FORMS_ROUNDS=1
+  step 120 40 5-forms forms FORMS_ROUNDS=1
   step 60 20 6-roofline bench BENCH=none
   step 150 60 7-largest large LARGE_LEVELS="${FIRST_LARGEST:-15}"
   step 60 20 8-why why
@@ -255,10 +256,13 @@ if [[ $stage == images ]]; then
 fi
 if [[ $stage == forms ]]; then
   for round in $(seq "${FORMS_ROUNDS:-2}"); do
-    for form in "9 1" "3 0" "9 0" "3 1"; do
-      read -r groups interleave <<< "$form"
-      echo "== forms: TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_INTERLEAVE=$interleave (round $round)"
-      TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_INTERLEAVE=$interleave \
+    # groups a pass, nodes a lane, rows interleaved: the default (§0zi),
+    # §0zh's, each of its choices alone, the forms before §0zh
+    for form in "9 4 1" "9 1 1" "3 4 1" "9 4 0" "3 1 0"; do
+      read -r groups lane interleave <<< "$form"
+      echo "== forms: TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_LANE_NODES=$lane" \
+        "TRESCA_DEVICE_INTERLEAVE=$interleave (round $round)"
+      TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_LANE_NODES=$lane TRESCA_DEVICE_INTERLEAVE=$interleave \
         bench "Device(Apply|ApplyFloat|VCycle)/$L/"
     done
     for sums in 1 0; do

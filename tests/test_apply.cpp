@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <Eigen/SparseCore>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -81,10 +82,14 @@ TEST(ElasticityApply, OptimisedEqualsReferenceIncludingPlaneRanges) {
 // the row-parallel form (the device's, here on host threads): the banded
 // apply's answers to rounding (the same per-node sums in the same order;
 // the compiler fuses multiply-adds differently in the two loops), on every
-// size, face set and block of rows, plain and fused
+// size, face set and block of rows, plain and fused; and on rows of 131 and
+// 151 nodes, whose runs of 128 nodes and more a lane sweeps 4 nodes at a
+// time (TRESCA_DEVICE_LANE_NODES, kernels/elasticity.cpp)
 TEST(ElasticityApply, RowFormEqualsTheBandedApply) {
+  std::vector<std::array<index, 3>> sizes = {{130, 1, 2}, {150, 2, 1}};
+  for (auto& s : kSizes) sizes.push_back({s[0], s[1], s[2]});
   test::for_each_isa([&](const IsaKernels&) {
-    for (auto& s : kSizes)
+    for (auto& s : sizes)
       for (unsigned faces : kFaceSets) {
         const GridDims g = test::prism(s[0], s[1], s[2]);
         const ElasticityStencil k = build_elasticity_stencil(g, faces, 1.0, 0.3);
@@ -167,7 +172,7 @@ TEST(ElasticityApply, EveryThreadCountGivesTheSameAnswerBitForBit) {
 // runs end in a partial vector (the banded apply's overlapping last vector
 // must put each entry once: the step is not idempotent).
 TEST(ElasticityApply, ChebyshevStepIsTheResidualAndTheUpdateInOneSweep) {
-  const index sizes[][3] = {{3, 2, 5}, {17, 3, 5}, {29, 2, 3}, {61, 1, 2}};
+  const index sizes[][3] = {{3, 2, 5}, {17, 3, 5}, {29, 2, 3}, {61, 1, 2}, {150, 1, 2}};
   const real t = 0.37;
   test::for_each_isa([&](const IsaKernels&) {
     for (auto& sz : sizes)
