@@ -152,6 +152,16 @@ long long setting(const char* name, long long fallback, long long lo, long long 
     throw std::invalid_argument(std::string(name) + "=" + e + " must be " + what);
   return v;
 }
+
+// A choice between two forms, a or b, in environment variable `name`
+// (`fallback` where unset): either value, or std::invalid_argument
+// saying "NAME=value must be a or b"
+int one_of(const char* name, int fallback, int a, int b) {
+  const std::string what = std::to_string(a) + " or " + std::to_string(b);
+  const int v = int(setting(name, fallback, std::min(a, b), std::max(a, b), what.c_str()));
+  if (v != a && v != b) throw std::invalid_argument(std::string(name) + "=" + std::to_string(v) + " must be " + what);
+  return v;
+}
 }  // namespace
 
 int device_warps() {
@@ -176,30 +186,22 @@ index device_min_nodes() {
 }
 
 int device_apply_groups() {
-  static const int groups = [] {
-    const int g = int(setting("TRESCA_DEVICE_GROUPS", 9, 3, 9, "3 or 9"));
-    if (g != 3 && g != 9) throw std::invalid_argument("TRESCA_DEVICE_GROUPS=" + std::to_string(g) + " must be 3 or 9");
-    return g;
-  }();
+  static const int groups = one_of("TRESCA_DEVICE_GROUPS", 9, 3, 9);
   return groups;
 }
 
 int device_lane_nodes() {
-  static const int nodes = [] {
-    const int u = int(setting("TRESCA_DEVICE_LANE_NODES", 4, 1, 4, "1 or 4"));
-    if (u != 1 && u != 4) throw std::invalid_argument("TRESCA_DEVICE_LANE_NODES=" + std::to_string(u) + " must be 1 or 4");
-    return u;
-  }();
+  static const int nodes = one_of("TRESCA_DEVICE_LANE_NODES", 4, 1, 4);
   return nodes;
 }
 
 bool device_rows_interleaved() {
-  static const bool on = setting("TRESCA_DEVICE_INTERLEAVE", 1, 0, 1, "0 or 1") == 1;
+  static const bool on = one_of("TRESCA_DEVICE_INTERLEAVE", 1, 0, 1) == 1;
   return on;
 }
 
 bool device_warp_sums() {
-  static const bool on = setting("TRESCA_DEVICE_WARP_SUMS", 1, 0, 1, "0 or 1") == 1;
+  static const bool on = one_of("TRESCA_DEVICE_WARP_SUMS", 1, 0, 1) == 1;
   return on;
 }
 
