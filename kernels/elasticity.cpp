@@ -251,7 +251,8 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
                            }
                        }
                      };
-                     if (U > 1 && i1 - i0 >= index(32) * U) return nodes_a_lane(lane);
+                     constexpr index kLanes = 32;  // a warp's (GCC's simd width on the GPU)
+                     if (U > 1 && i1 - i0 >= kLanes * U) return nodes_a_lane(lane);
                      nodes_a_lane(std::integral_constant<int, 1>{});
                    });
     });
