@@ -166,7 +166,7 @@ if [[ $stage == first ]]; then
   echo "== summary (whole logs above, and in run_first.log where OUT is set)"
   keep='^\[ +(PASSED|FAILED) +\]|_median|^== |largest difference|sets equal|iterations .* vs|same solution|DIFFERENT'
   keep+='|^(converged|not converged)|^work: .*peak|^times \[s\]|^# device|^apply y = Kx|^(apply \(float\)|dot|axpy|cg_update) +[0-9]|^V-cycle \('
-  keep+='|exit status [1-9]|error|refused|^fixture:'
+  keep+='|exit status [1-9]|error|refused|^fixture:|^Device[A-Za-z]+/[0-9]+: '
   keep+='| (device|copy) +[0-9]+ +[0-9.]+ +([5-9]|[1-9][0-9])\.[0-9]%|^in launches:'  # (kernels of 5 % and more)
   for f in "$out"/*.log; do
     echo "-- ${f##*/}"
@@ -255,6 +255,7 @@ if [[ $stage == images ]]; then
   done
 fi
 if [[ $stage == forms ]]; then
+  mkdir -p "$out"
   for round in $(seq "${FORMS_ROUNDS:-2}"); do
     # groups a pass, nodes a lane, rows interleaved: the default (§0zi),
     # §0zh's, each of its choices alone, the forms before §0zh
@@ -269,7 +270,39 @@ if [[ $stage == forms ]]; then
       echo "== forms: TRESCA_DEVICE_WARP_SUMS=$sums (round $round)"
       TRESCA_DEVICE_WARP_SUMS=$sums bench "Device(Dot|CgUpdate)/$V/"
     done
-  done
+  done | tee "$out/forms.log"
+  # the verdict: each benchmark's forms, fastest first (DoF/s, the mean of
+  # the rounds' medians)
+  echo "== forms: the verdict (DoF/s, fastest first)"
+  awk '
+    function num(v) {  # 4.89G/s -> 4.89e9
+      sub(/\/s$/, "", v)
+      m = substr(v, length(v)); x = v + 0
+      return m == "k" ? x * 1e3 : m == "M" ? x * 1e6 : m == "G" ? x * 1e9 : m == "T" ? x * 1e12 : x
+    }
+    /^== forms: / {
+      form = $0; sub(/^== forms: /, "", form); sub(/ \(round [0-9]+\)$/, "", form); gsub(/TRESCA_DEVICE_/, "", form)
+      next
+    }
+    /_median/ {
+      name = $1; sub(/\/real_time_median$/, "", name)
+      for (i = 2; i <= NF; i++) if ($i ~ /^DoF\/s=/) { v = $i; sub(/^DoF\/s=/, "", v) }
+      key = name SUBSEP form
+      if (!(key in n)) { order[name] = order[name] SUBSEP form; if (!(name in seen)) { seen[name] = 1; names[++nn] = name } }
+      sum[key] += num(v); n[key]++
+    }
+    END {
+      for (k = 1; k <= nn; k++) {
+        name = names[k]; m = split(substr(order[name], 2), forms, SUBSEP)
+        for (i = 1; i <= m; i++) rate[i] = sum[name SUBSEP forms[i]] / n[name SUBSEP forms[i]]
+        for (i = 1; i <= m; i++)  # (a few forms: a selection sort)
+          for (j = i + 1; j <= m; j++)
+            if (rate[j] > rate[i]) { t = rate[i]; rate[i] = rate[j]; rate[j] = t; f = forms[i]; forms[i] = forms[j]; forms[j] = f }
+        printf "%s:", name
+        for (i = 1; i <= m; i++) printf "%s %s %.3g", (i > 1 ? ";" : ""), forms[i], rate[i]
+        printf "\n"
+      }
+    }' "$out/forms.log"
 fi
 if [[ $stage == why ]]; then
   filter='Device(Apply|ApplyFloat)/12/|Device(Axpy|Dot|CgUpdate)/16777216/'
