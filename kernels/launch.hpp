@@ -47,7 +47,8 @@ void set_launch_on_device(bool on);  // throws std::invalid_argument if the buil
 bool offload_built();                // whether this build has TRESCA_OFFLOAD
 // "device 0 of 1 (OpenMP offload: NVIDIA H100 80GB HBM3, 85.0 GB), 8 warps
 // a team, multigrid levels and coarser meshes under 32768 nodes on the
-// host, the apply 9 groups a pass, rows interleaved, sums a block a warp",
+// host, the apply 9 groups a pass and 4 nodes a lane, rows interleaved,
+// sums a block a warp",
 // "none: target regions run on the host, 8 warps a team, ..." or "none
 // (built without offload)"
 std::string device_description();
@@ -118,7 +119,7 @@ index device_min_nodes();
 int device_apply_groups();
 int device_lane_nodes();
 bool device_rows_interleaved();
-// A third such choice, in the device form of the deterministic sums
+// A fourth such choice, in the device form of the deterministic sums
 // (sum_over_blocks: dot products, the fused CG updates): a block of 4096
 // entries summed by one warp across its lanes (TRESCA_DEVICE_WARP_SUMS=1,
 // the default), or by a team, which opens a parallel region for each block
