@@ -85,28 +85,34 @@ inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, cons
   }
 }
 
+// `lead`: the offset from a node to its input that no row before it in the
+// band's order read (one plane and one row on: apply_band)
 template <OutKind K, class T>
 inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* xr, const ApplyOut<T> o,
-                          const T* x, index row, index N, index i0, index i1) {
+                          const T* x, index row, index N, index i0, index i1, index lead) {
   constexpr int kLanes = Simd<T>::lanes;
   // three vectors per block: 9 accumulators + 3 inputs fit the 16 registers of
   // SSE/AVX2 (and AVX-512's 32); the width is measured (perf/RESULTS.md §0i)
   constexpr int kW = 3 * kLanes;
+  constexpr int kLine = 64 / sizeof(T);  // entries a 64-byte line
   index i = i0;
   for (; i + kW <= i1; i += kW) {
-    if constexpr (K == OutKind::step || K == OutKind::step_first) {
-      // the next block's lines of b, dinv and d (64-byte lines): the step's
-      // epilogue otherwise misses on them in a burst after the block's
-      // arithmetic (15 % slower than two sweeps on one thread, RESULTS.md §0p)
-      constexpr int kLine = 64 / sizeof(T);
-      for (int a = 0; a < 3; ++a)
-        for (int l = 0; l < kW; l += kLine) {
-          const index j = a * N + row + i + kW + l;
-          __builtin_prefetch(o.b + j);
-          __builtin_prefetch(o.dinv + j);
-          if constexpr (K == OutKind::step) __builtin_prefetch(o.d + j, 1);
+    // The next block's lines that come from memory: the lead input row's
+    // (every other input row was read by the rows before, and is in cache),
+    // and for the smoother's step those of b, dinv and d, which its epilogue
+    // otherwise misses on in a burst after the block's arithmetic. The
+    // hardware's prefetchers alone leave the apply a third slower on
+    // meshes that do not fit the caches (RESULTS.md §0p, §0zj).
+    for (int a = 0; a < 3; ++a)
+      for (int l = 0; l < kW; l += kLine) {
+        const index j = a * N + i + kW + l;
+        __builtin_prefetch(xr + lead + j);
+        if constexpr (K == OutKind::step || K == OutKind::step_first) {
+          __builtin_prefetch(o.b + row + j);
+          __builtin_prefetch(o.dinv + row + j);
+          if constexpr (K == OutKind::step) __builtin_prefetch(o.d + row + j, 1);
         }
-    }
+      }
     stencil_block<K, T, kW>(g, f, xr, o, x, row, N, i);
   }
   for (; i + kLanes <= i1; i += kLanes) stencil_block<K, T, kLanes>(g, f, xr, o, x, row, N, i);
@@ -123,12 +129,15 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
 template <class T>
 void apply_band(const StencilView<T>& v, const T* x, const ApplyOut<T>& o, const RowBlock& rows) {
   const index nx = v.g.nx(), ny = v.g.ny(), N = v.g.nodes();
+  // rows go in z, then y order: row (iy, iz) is the first to read row
+  // (iy + 1, iz + 1) of x (a prefetch only: past the grid's end it reads nothing)
+  const index lead = nx * ny + nx;
   with_kind(o, [&](auto kind) {
     constexpr OutKind K = decltype(kind)::value;
     for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
       for (index iy = rows.y_begin; iy < rows.y_end; ++iy)
         sweep_row<K>(v, nx, ny, N, iz, iy, x, o, [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
-          stencil_range<K, T>(v.groups, f, xr, o, x, row, N, i0, i1);
+          stencil_range<K, T>(v.groups, f, xr, o, x, row, N, i0, i1, lead);
         });
   });
 }

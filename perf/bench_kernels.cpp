@@ -86,6 +86,28 @@ BENCHMARK_TEMPLATE(BM_Apply, float, Run::host)->Name("ApplyFloat")->DenseRange(6
 BENCHMARK_TEMPLATE(BM_Apply, double, Run::ref)->Name("ApplyRef")->DenseRange(6, 10, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_Apply, double, Run::device)->Name("DeviceApply")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_Apply, float, Run::device)->Name("DeviceApplyFloat")->DenseRange(8, 13)->UseRealTime()->Unit(benchmark::kMillisecond);
+// The apply on a brick of ex x ey x ez elements (double, the x = 0 face
+// clamped), by the shape of its fields: long rows that stay in cache
+// (1008x4x4), short ones (64x4x4), and a level-12-sized brick that does not
+// fit the caches (256x128x128), so that the cost of a node in cache, of a
+// row's ends and of the memory read apart. ns/node: time a node.
+void BM_ApplyShape(benchmark::State& st) {
+  GridDims g;
+  g.ex = st.range(0);
+  g.ey = st.range(1);
+  g.ez = st.range(2);
+  const ElasticityStencil k = build_elasticity_stencil(g, kFaceX0, 2e11, 0.3);
+  Field<real> x = placed_field<real>(ramp(k.size())), y(k.size());
+  for (auto _ : st) {
+    elasticity_apply<real>(k, x.data(), y.data(), 0, g.nz());
+    benchmark::DoNotOptimize(y.data());
+    benchmark::ClobberMemory();
+  }
+  st.counters["ns/node"] = benchmark::Counter(double(g.nodes()) * double(st.iterations()),
+                                              benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  set_rates(st, double(k.size()), kApplyCost.bytes / 3, kApplyCost.flops / 3);
+}
+BENCHMARK(BM_ApplyShape)->Name("ApplyShape")->Args({1008, 4, 4})->Args({64, 4, 4})->Args({256, 128, 128})->UseRealTime()->Unit(benchmark::kMillisecond);
 
 // One Chebyshev step of the smoother on a level's vectors, in the V-cycle's
 // float: fused into the apply (kernels/apply_out.hpp: the sweep writes d and
@@ -209,7 +231,8 @@ BENCHMARK_TEMPLATE(BM_Vector, 2, Run::device)->Name("DeviceCgUpdate")->Arg(1 << 
 static const char* kHelp =
     "usage: bench_kernels [Google Benchmark options]\n"
     "The kernels one by one on the fields of mesh levels 6-12 (Apply, ApplyFloat, ApplyRef: the\n"
-    "serial _ref twin, VCycle, RestrictProlong, Dot), each with the counters DoF/s, bytes/s and\n"
+    "serial _ref twin, ApplyShape: the apply by the shape of its brick, with ns/node, VCycle,\n"
+    "RestrictProlong, Dot), each with the counters DoF/s, bytes/s and\n"
     "FLOP/s from the kernels' cost models, omp_threads and dofs; the build (ISA, vector width,\n"
     "compiler) and the offload device are in the context header. VCycle also counts its\n"
     "launches (regions: parallel regions a cycle, one_thread: launches too small for threads);\n"
