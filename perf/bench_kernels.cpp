@@ -89,8 +89,9 @@ BENCHMARK_TEMPLATE(BM_Apply, float, Run::device)->Name("DeviceApplyFloat")->Dens
 // The apply on a brick of ex x ey x ez elements (double, the x = 0 face
 // clamped), by the shape of its fields: long rows that stay in cache
 // (1008x4x4), short ones (64x4x4), and a level-12-sized brick that does not
-// fit the caches (256x128x128), so that the cost of a node in cache, of a
-// row's ends and of the memory read apart. ns/node: time a node.
+// fit the caches (256x128x128): what a node costs in cache, what a row's
+// ends add, and what the memory adds can be read apart. ns/node: the time
+// a node (perf/RESULTS.md §0zj).
 void BM_ApplyShape(benchmark::State& st) {
   GridDims g;
   g.ex = st.range(0);
