@@ -150,6 +150,8 @@ def main():
     ap.add_argument("--limit", action="append", default=[], metavar="IMAGE=N",
                     help="exit 1 if the kernels of the image whose file name contains IMAGE use more than N")
     a = ap.parse_args()
+    if not os.path.isfile(a.binary):
+        ap.error(f"{a.binary}: no such program")
     limits = []
     for spec in a.limit:
         m = re.fullmatch(r"([^=]+)=(\d+)", spec)
