@@ -46,10 +46,13 @@ inline void accumulate(const StencilGroupT<T>* g, const StencilGroupT<T>* ge, co
 // Entries [i, i+W) of the row starting at node `row`, for the 3 output
 // components of one stencil (f = first + 7*s), handed to put() (apply_out.hpp);
 // xr = x + row. The first `done` entries are computed but not put (they
-// were: a Chebyshev step's put may not run twice on an entry).
+// were: a Chebyshev step's put may not run twice on an entry). Always
+// inlined: GCC otherwise calls the smoother step's copy once a block, and
+// the fused step at level 12 runs 5-12 % slower (RESULTS.md §0zj).
 template <OutKind K, class T, int W>
-inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f, const T* xr, const ApplyOut<T> o,
-                          const T* x, index row, index N, index i, int done = 0) {
+__attribute__((always_inline)) inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f,
+                                                         const T* xr, const ApplyOut<T> o, const T* x, index row,
+                                                         index N, index i, int done = 0) {
   using V = Vec<T>;
   constexpr int kLanes = Simd<T>::lanes;
   if constexpr (W % kLanes != 0) {
