@@ -149,7 +149,7 @@ if [[ $stage == first ]]; then
   fi
   if [[ -f $base/tests/earlier_forms_pass ]]; then
     echo "== first: the default forms fail device tests that the earlier forms pass: the other steps run with $earlier_forms"
-    # shellcheck disable=SC2086 # (three assignments)
+    # shellcheck disable=SC2086 # (its assignments, split on purpose)
     export $earlier_forms
   fi
   step 120 30 2-bench bench BENCH="Device(Apply|ApplyFloat|VCycle|RestrictProlong)/$L/|Device(Dot|Axpy|CgUpdate)/$V/|Device(Axpy|Dot)/1024/" NO_ROOFLINE=1
@@ -196,7 +196,7 @@ if [[ $stage == tests || $stage == all ]]; then
   # they pass so, `first` runs its other steps with those forms
   if [[ -n $failed ]]; then
     echo "== the failing tests again with the earlier forms: $earlier_forms"
-    # shellcheck disable=SC2086 # (three assignments)
+    # shellcheck disable=SC2086 # (its assignments, split on purpose)
     env $earlier_forms "$bin/test_device" --gtest_filter="$failed" > "$out/earlier_forms.log" 2>&1 && earlier=0 ||
       earlier=$?
     grep -E '^\[ +(PASSED|FAILED) +\]' "$out/earlier_forms.log" || true
