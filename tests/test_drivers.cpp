@@ -283,9 +283,14 @@ TEST(TrescaDriver, WithoutLoadTheBodyStaysAtRest) {
 TEST(TrescaDriver, NearlyIncompressibleMaterialEndsInSecondsWithAVerifiedAnswer) {
   // issue 11: nu = 0.4999 on 16x8x8 ground on for 825 s before stagnation;
   // then two Newton steps in a row with the boundary CG at its limit stopped
-  // it (outer_solver_failure); with the line search it converges in 7 steps
-  // (8.5 s), and the final check verifies the KKT conditions
-  expect_run("tresca --dims 16x8x8 --nu 0.4999 --quiet", 0, "tolerance 9.55e-03 N: ok");
+  // it (outer_solver_failure); with the line search it converges in 5 steps
+  // (6 s), and the final check verifies the KKT conditions. The tolerance
+  // is 10x what the inner solves attain here: |v| stalls at 1e-6 to 5e-6 N
+  // (some 5e-14 of its start), where whether a step lands under the
+  // default 1e-6 is a matter of rounding. Around nu = 0.4999 runs take 5 to
+  // 12 steps, and a change of the coarse solve's rounding alone once made
+  // this one stagnate (RESULTS.md §0zk)
+  expect_run("tresca --dims 16x8x8 --nu 0.4999 --eps 5e-5 --quiet", 0, "tolerance 9.55e-03 N: ok");
 }
 
 TEST(TrescaDriver, ReportsAFullStandardOutput) {

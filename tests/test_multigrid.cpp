@@ -9,6 +9,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "core/solvers/cg.hpp"
+#include "core/multigrid/coarse_solver.hpp"
 #include "core/multigrid/interior.hpp"
 #include "core/multigrid/multigrid.hpp"
 #include "core/multigrid/smoothing.hpp"
@@ -152,6 +153,63 @@ TEST(MultigridCG, MatchesSparseDirectSolveOnOddMeshes) {
     }
     EXPECT_LT(err, 1e-9 * scale) << s[0] << "x" << s[1] << "x" << s[2];
   }
+}
+
+// The coarsest level's direct solve (coarse_solver.hpp): (K + B)^-1 b
+// against Eigen's sparse LDLT of the assembled K + B, for K alone and three
+// bottom blocks in turn (the last with the Newton step's penalties, 1e4
+// times K's diagonal), on both of its paths (the face's Schur complement
+// kept dense; the whole refactorised), with x = 0 clamped (the face leaves
+// its nodes out) and with the bottom face clamped too (no face at all)
+TEST(CoarseSolver, SolvesKPlusEachBottomBlockLikeASparseLDLTOnBothPaths) {
+  for (unsigned faces : {unsigned(kFaceX0), unsigned(kFaceX0 | kFaceZ0)})
+    for (index max_dense : {CoarseSolver::kMaxDenseFace, index(0)}) {
+      ElasticityOperator A(test::prism(8, 4, 4), faces, 2.1e9, 0.277);
+      const GridDims& g = A.grid();
+      const index M = g.nx() * g.ny();
+      const SparseMatrix K = assemble_stiffness(A);
+      const std::vector<index> face = bottom_block_dofs(g, faces);
+      EXPECT_EQ(index(face.size()), faces & kFaceZ0 ? 0 : 3 * (M - g.ny()));
+      CoarseSolver coarse(max_dense);
+      coarse.factor(K, face);
+      EXPECT_EQ(coarse.dense_face(), index(face.size()) <= max_dense);
+      const std::vector<real> r = test::random_vector(4 * M, 31);
+      for (int k = 0; k < 4; ++k) {
+        std::vector<real> B;  // k = 0: none
+        if (k > 0) {
+          B.assign(4 * M, 0.0);
+          const real scale = k == 3 ? 1e4 : k;
+          for (index n = 0; n < M; ++n) {
+            const real bxx = scale * (1 + r[n]) * K.coeff(n, n), byy = scale * (1 + r[2 * M + n]) * K.coeff(M, M);
+            B[n] = bxx;
+            B[M + n] = 0.5 * r[M + n] * std::sqrt(bxx * byy);  // (|r| < 1: each 2x2 block positive)
+            B[2 * M + n] = byy;
+            B[3 * M + n] = scale * (1 + r[3 * M + n]) * K.coeff(n, n);
+          }
+        }
+        A.set_bottom_block(B);  // (zero on constrained nodes)
+        if (k > 0) coarse.update(assemble_bottom_block(g, A.bottom_block().to_vector()));
+        // b = (K + B) u for u of entries in [-1, 1] (so that K's identity
+        // rows on clamped dofs do not dominate the norms)
+        const SparseMatrix KB = assemble(A);
+        const std::vector<real> uv = test::random_vector(A.size(), 32 + k);
+        const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(uv.data(), A.size());
+        const Eigen::VectorXd b = KB * u;
+        Eigen::VectorXd x;
+        coarse.solve(b, x);
+        const Eigen::VectorXd xr = Eigen::SimplicialLDLT<SparseMatrix>(KB).solve(b);
+        EXPECT_LT((xr - u).norm(), 1e-13 * u.norm()) << "the reference, block " << k;
+        EXPECT_LT((x - u).norm(), 1e-13 * u.norm())
+            << "faces " << faces << ", max_dense " << max_dense << ", block " << k;
+        EXPECT_LT((KB * x - b).norm(), 1e-14 * b.norm())
+            << "faces " << faces << ", max_dense " << max_dense << ", block " << k;
+      }
+      if (coarse.dense_face()) {  // a B off the face is refused where only the face is kept
+        SparseMatrix off(A.size(), A.size());
+        off.insert(M + 1, M + 1) = 1.0;  // (node (1, 0, 1), above the bottom plane)
+        EXPECT_THROW(coarse.update(off), std::invalid_argument);
+      }
+    }
 }
 
 TEST(MultigridCG, SinglePrecisionVCycleKeepsIterationsAndAccuracy) {

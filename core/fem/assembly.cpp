@@ -1,10 +1,12 @@
 #include "core/fem/assembly.hpp"
 
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace tresca {
 
-SparseMatrix assemble(const ElasticityOperator& op) {
+SparseMatrix assemble_stiffness(const ElasticityOperator& op) {
   const GridDims& g = op.grid();
   const ElasticityStencil& k = op.stencil();
   const index N = g.nodes();
@@ -33,19 +35,45 @@ SparseMatrix assemble(const ElasticityOperator& op) {
       for (index ix = 0; ix < g.nx(); ++ix)
         if (node_constrained(g, op.faces(), ix, iy, iz))
           for (int a = 0; a < 3; ++a) t.emplace_back(a * N + g.node(ix, iy, iz), a * N + g.node(ix, iy, iz), 1.0);
-  const std::vector<real> B = op.bottom_block().to_vector();  // (wherever it lives)
-  if (!B.empty()) {
-    const index M = g.nx() * g.ny();
-    for (index n = 0; n < M; ++n) {
-      t.emplace_back(n, n, B[n]);
-      t.emplace_back(n, N + n, B[M + n]);
-      t.emplace_back(N + n, n, B[M + n]);
-      t.emplace_back(N + n, N + n, B[2 * M + n]);
-      t.emplace_back(2 * N + n, 2 * N + n, B[3 * M + n]);
-    }
-  }
   SparseMatrix A(3 * N, 3 * N);
   A.setFromTriplets(t.begin(), t.end());
+  A.prune(0.0);
+  return A;
+}
+
+SparseMatrix assemble_bottom_block(const GridDims& g, const std::vector<real>& B) {
+  const index N = g.nodes(), M = g.nx() * g.ny();
+  SparseMatrix A(3 * N, 3 * N);
+  if (B.empty()) return A;
+  if (index(B.size()) != 4 * M)
+    throw std::invalid_argument("assemble_bottom_block: " + std::to_string(B.size()) + " entries, expected 4 x " +
+                                std::to_string(M));
+  std::vector<Eigen::Triplet<real, index>> t;
+  t.reserve(std::size_t(5 * M));
+  for (index n = 0; n < M; ++n) {  // (the bottom plane's nodes are the grid's first M)
+    t.emplace_back(n, n, B[n]);
+    t.emplace_back(n, N + n, B[M + n]);
+    t.emplace_back(N + n, n, B[M + n]);
+    t.emplace_back(N + n, N + n, B[2 * M + n]);
+    t.emplace_back(2 * N + n, 2 * N + n, B[3 * M + n]);
+  }
+  A.setFromTriplets(t.begin(), t.end());
+  return A;
+}
+
+std::vector<index> bottom_block_dofs(const GridDims& g, unsigned faces) {
+  const index N = g.nodes();
+  std::vector<index> dofs;
+  for (int a = 0; a < 3; ++a)
+    for (index iy = 0; iy < g.ny(); ++iy)
+      for (index ix = 0; ix < g.nx(); ++ix)
+        if (!node_constrained(g, faces, ix, iy, 0)) dofs.push_back(a * N + g.node(ix, iy, 0));
+  return dofs;
+}
+
+SparseMatrix assemble(const ElasticityOperator& op) {
+  SparseMatrix A = assemble_stiffness(op);
+  if (!op.bottom_block().empty()) A += assemble_bottom_block(op.grid(), op.bottom_block().to_vector());
   A.prune(0.0);
   return A;
 }

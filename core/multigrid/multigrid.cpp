@@ -335,29 +335,16 @@ real Multigrid::estimate_lmax(int l, const ElasticityOperator& A, const Field<T>
 }
 
 void Multigrid::factor_coarse() {
-  // rank 0 factorises and solves the coarsest level (vcycle)
-  const index n = levels_.back().A.size();
+  // rank 0 factorises and solves the coarsest level (vcycle): K once, with
+  // the dofs where a bottom block lands (set_bottom_block: the bottom
+  // plane's unconstrained nodes) ordered last (coarse_solver.hpp)
+  const ElasticityOperator& C = levels_.back().A;
+  const index n = C.size();
   cb_.resize(n);
   cx_.resize(n);
   if (comm().rank() != 0) return;
-  SparseMatrix A = assemble(levels_.back().A);
-  A.makeCompressed();
-  const index* outer = A.outerIndexPtr();
-  const index* inner = A.innerIndexPtr();
-  const std::size_t cols = std::size_t(A.outerSize()) + 1, nnz = std::size_t(A.nonZeros());
-  const bool same = coarse_outer_.size() == cols && coarse_inner_.size() == nnz &&
-                    std::equal(outer, outer + cols, coarse_outer_.begin()) &&
-                    std::equal(inner, inner + nnz, coarse_inner_.begin());
-  if (!same) {  // the ordering (AMD) and the symbolic factorisation, once per pattern
-    coarse_.analyzePattern(A);
-    coarse_outer_.assign(outer, outer + cols);
-    coarse_inner_.assign(inner, inner + nnz);
-  }
-  coarse_.factorize(A);
-  if (coarse_.info() != Eigen::Success) {
-    coarse_outer_.clear();  // (analysed afresh next time)
-    throw std::runtime_error("multigrid: coarse factorisation failed");
-  }
+  TRESCA_ASSERT(C.bottom_block().empty());
+  coarse_.factor(assemble_stiffness(C), bottom_block_dofs(C.grid(), C.faces()));
 }
 
 void Multigrid::set_bottom_block(const std::vector<real>& B) {
@@ -376,7 +363,10 @@ void Multigrid::set_bottom_block(const std::vector<real>& B) {
     if (l + 1 == levels_.size() || Bl.empty()) continue;
     Bl = project_bottom_block(grids_->to_coarse[l].whole, Bl);  // P^T B
   }
-  factor_coarse();
+  if (comm().rank() == 0) {
+    const ElasticityOperator& C = levels_.back().A;
+    coarse_.update(assemble_bottom_block(C.grid(), C.bottom_block().to_vector()));
+  }
   if (opt_.precision == Precision::single_precision)
     refresh_work<float>();
   else
@@ -458,7 +448,7 @@ void Multigrid::vcycle(int l) const {
     std::vector<T> v(n);
     space_copy(Space::host, v.data(), launch_space(), w.bp, n * sizeof(T));
     for (index i = 0; i < n; ++i) cb_[i] = real(v[i]);
-    cx_ = coarse_.solve(cb_);
+    coarse_.solve(cb_, cx_);
     for (index i = 0; i < n; ++i) v[i] = T(cx_[i]);
     space_copy(launch_space(), w.xp, Space::host, v.data(), n * sizeof(T));
     return;

@@ -61,7 +61,6 @@
 // vector from which the post-smoother's steps, alternating between two
 // vectors, end in x, so that smoother needs no residual sweep either.
 #pragma once
-#include <Eigen/SparseCholesky>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -73,6 +72,7 @@
 #include "kernels/transfer.hpp"
 #include "core/fem/assembly.hpp"
 #include "core/fem/elasticity_operator.hpp"
+#include "core/multigrid/coarse_solver.hpp"
 #include "core/parallel/comm.hpp"
 #include "core/parallel/row_fetch.hpp"
 
@@ -292,10 +292,7 @@ class Multigrid : public LinearOperator {
   std::shared_ptr<const GridHierarchy> grids_;
   std::vector<Level> levels_;
   std::tuple<InPrecision<double>, InPrecision<float>> held_;
-  Eigen::SimplicialLDLT<SparseMatrix> coarse_;  // on rank 0 (every rank when all levels are whole)
-  // the pattern coarse_ was ordered for (its fill-reducing ordering is kept
-  // while the pattern stays: each bottom block only refactorises)
-  std::vector<index> coarse_outer_, coarse_inner_;
+  CoarseSolver coarse_;  // on rank 0 (every rank when all levels are whole)
   mutable Eigen::VectorXd cb_, cx_;
 };
 
