@@ -14,7 +14,7 @@
 #   ranks     scaling --ranks 1,2,4,8,16 on level 12
 #   roofline  roofline --level 12 with all cores: every kernel against the triad
 #   large     levels 13 and 14 with all cores, then level 15 (memory
-#             estimate, time, peak memory)
+#             estimate, progress lines, time, peak memory)
 #   profile   where the threads' time goes: level 12's kernel profile with 1
 #             thread and with all cores (with the fork/join census and the
 #             memory made), and the price of one parallel region
@@ -42,7 +42,8 @@ echo "# stage $stage, $T threads or ranks"
 run() {  # a command, echoed, then its last TAIL lines (or those matching KEEP)
   echo "\$ $*"
   if [ -n "${KEEP:-}" ]; then
-    { "$@" 2>&1 || echo "(exit status $?)"; } | grep -E "$KEEP|exit status"
+    # (line by line: what a run cut short by the command's time limit printed still comes back)
+    { "$@" 2>&1 || echo "(exit status $?)"; } | grep --line-buffered -E "$KEEP|exit status"
   else
     { "$@" 2>&1 || echo "(exit status $?)"; } | tail -n "${TAIL:-3}"
   fi
@@ -73,7 +74,7 @@ case $stage in
     TAIL=30 run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores "$b/bin/roofline" --level "$L" ;;
   large)
     for level in 13 14 15; do
-      KEEP="$solve|estimated|converged" run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores \
+      KEEP="$solve|estimated|converged|nested:|^  it " run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores \
         "$b/bin/tresca" --level "$level"
     done ;;
   profile)
