@@ -11,7 +11,9 @@
 // rediscretised (same brick formula, coarse h). Transfers are trilinear
 // interpolation and its exact transpose (kernels/transfer.hpp). Coarsening
 // stops when a grid has at most `coarse_nodes` nodes; that grid is solved
-// directly (Eigen sparse LDLT of the assembled matrix, factorised once).
+// directly (coarse_solver.hpp: Eigen's sparse LDLT of the assembled K,
+// factorised once; a bottom block is a dense update of K's Schur
+// complement on the bottom plane).
 //
 // Ranks: a level is either whole or split into y-slabs (slab.hpp), one per
 // rank. One rank is the case where every level is whole. On several ranks,
