@@ -7,37 +7,52 @@
 namespace tresca {
 
 SparseMatrix assemble_stiffness(const ElasticityOperator& op) {
+  // Column by column (dof b of node m, in order), each from the up to 8
+  // elements around m, in the order of their index (the sums of an
+  // element-by-element assembly, bit for bit), into the column's up to 3 x 27
+  // rows (component a of each neighbour n = m + off[d], in order), without
+  // the sort of a triplet list (RESULTS.md §0zk)
   const GridDims& g = op.grid();
   const ElasticityStencil& k = op.stencil();
-  const index N = g.nodes();
-  std::vector<Eigen::Triplet<real, index>> t;
-  t.reserve(size_t(g.ex * g.ey * g.ez) * 576);
-  for (index ez = 0; ez < g.ez; ++ez)
-    for (index ey = 0; ey < g.ey; ++ey)
-      for (index ex = 0; ex < g.ex; ++ex) {
-        index nodes[8];
-        bool fixed[8];
-        for (int L = 0; L < 8; ++L) {
-          const index ix = ex + (L & 1), iy = ey + ((L >> 1) & 1), iz = ez + ((L >> 2) & 1);
-          nodes[L] = g.node(ix, iy, iz);
-          fixed[L] = node_constrained(g, op.faces(), ix, iy, iz);
-        }
-        for (int L = 0; L < 8; ++L)
-          for (int M = 0; M < 8; ++M) {
-            if (fixed[L] || fixed[M]) continue;
-            for (int a = 0; a < 3; ++a)
-              for (int b = 0; b < 3; ++b)
-                t.emplace_back(a * N + nodes[L], b * N + nodes[M], k.Ke[24 * (3 * L + a) + 3 * M + b]);
-          }
-      }
+  const index N = g.nodes(), nx = g.nx(), ny = g.ny();
+  std::vector<char> fixed(static_cast<std::size_t>(N));
   for (index iz = 0; iz < g.nz(); ++iz)
-    for (index iy = 0; iy < g.ny(); ++iy)
-      for (index ix = 0; ix < g.nx(); ++ix)
-        if (node_constrained(g, op.faces(), ix, iy, iz))
-          for (int a = 0; a < 3; ++a) t.emplace_back(a * N + g.node(ix, iy, iz), a * N + g.node(ix, iy, iz), 1.0);
+    for (index iy = 0; iy < ny; ++iy)
+      for (index ix = 0; ix < nx; ++ix) fixed[std::size_t(g.node(ix, iy, iz))] = node_constrained(g, op.faces(), ix, iy, iz);
+  index off[27];  // neighbour d = 9 (dz + 1) + 3 (dy + 1) + dx + 1 at node offset off[d], increasing
+  for (int d = 0; d < 27; ++d) off[d] = (d % 3 - 1) + nx * ((d / 3) % 3 - 1) + nx * ny * (d / 9 - 1);
   SparseMatrix A(3 * N, 3 * N);
-  A.setFromTriplets(t.begin(), t.end());
-  A.prune(0.0);
+  A.reserve(std::size_t(3 * N) * 81);
+  for (int b = 0; b < 3; ++b)
+    for (index m = 0; m < N; ++m) {
+      const index col = b * N + m;
+      A.startVec(col);
+      if (fixed[std::size_t(m)]) {  // (a constrained dof: its identity row and column)
+        A.insertBack(col, col) = 1.0;
+        continue;
+      }
+      const index ix = m % nx, iy = (m / nx) % ny, iz = m / (nx * ny);
+      real acc[3][27] = {};
+      bool near[27] = {};
+      for (int sz = 1; sz >= 0; --sz)  // (elements in index order)
+        for (int sy = 1; sy >= 0; --sy)
+          for (int sx = 1; sx >= 0; --sx) {
+            const index ex = ix - sx, ey = iy - sy, ez = iz - sz;
+            if (ex < 0 || ey < 0 || ez < 0 || ex >= g.ex || ey >= g.ey || ez >= g.ez) continue;
+            const int Lm = sx + 2 * sy + 4 * sz;  // m's corner of the element
+            for (int Ln = 0; Ln < 8; ++Ln) {
+              const int dx = (Ln & 1) - sx, dy = ((Ln >> 1) & 1) - sy, dz = ((Ln >> 2) & 1) - sz;
+              const int d = 9 * (dz + 1) + 3 * (dy + 1) + dx + 1;
+              if (fixed[std::size_t(m + off[d])]) continue;
+              near[d] = true;
+              for (int a = 0; a < 3; ++a) acc[a][d] += k.Ke[24 * (3 * Ln + a) + 3 * Lm + b];
+            }
+          }
+      for (int a = 0; a < 3; ++a)
+        for (int d = 0; d < 27; ++d)
+          if (near[d] && acc[a][d] != 0) A.insertBack(a * N + m + off[d], col) = acc[a][d];
+    }
+  A.finalize();
   return A;
 }
 

@@ -1,6 +1,8 @@
-// Assembled sparse stiffness (Eigen), built element by element from Ke with
-// the same constraint convention as the matrix-free operator (constrained
-// rows/columns replaced by identity) plus the optional bottom-face blocks.
+// Assembled sparse stiffness (Eigen), summed from the element matrix Ke
+// (each column from the elements around its node, in element order: the
+// sums of an element-by-element assembly) with the same constraint
+// convention as the matrix-free operator (constrained rows/columns replaced
+// by identity), plus the optional bottom-face blocks.
 // Used for the coarsest multigrid level and as an independent test oracle.
 #pragma once
 #include <Eigen/SparseCore>
