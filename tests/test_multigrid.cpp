@@ -166,7 +166,7 @@ TEST(CoarseSolver, SolvesKPlusEachBottomBlockLikeASparseLDLTOnBothPaths) {
     for (index max_dense : {CoarseSolver::kMaxDenseFace, index(0)}) {
       ElasticityOperator A(test::prism(8, 4, 4), faces, 2.1e9, 0.277);
       const GridDims& g = A.grid();
-      const index M = g.nx() * g.ny();
+      const index M = g.nx() * g.ny(), N = g.nodes();
       const SparseMatrix K = assemble_stiffness(A);
       const std::vector<index> face = bottom_block_dofs(g, faces);
       EXPECT_EQ(index(face.size()), faces & kFaceZ0 ? 0 : 3 * (M - g.ny()));
@@ -180,11 +180,12 @@ TEST(CoarseSolver, SolvesKPlusEachBottomBlockLikeASparseLDLTOnBothPaths) {
           B.assign(4 * M, 0.0);
           const real scale = k == 3 ? 1e4 : k;
           for (index n = 0; n < M; ++n) {
-            const real bxx = scale * (1 + r[n]) * K.coeff(n, n), byy = scale * (1 + r[2 * M + n]) * K.coeff(M, M);
+            const real bxx = scale * (1 + r[n]) * K.coeff(n, n);
+            const real byy = scale * (1 + r[2 * M + n]) * K.coeff(N + n, N + n);
             B[n] = bxx;
             B[M + n] = 0.5 * r[M + n] * std::sqrt(bxx * byy);  // (|r| < 1: each 2x2 block positive)
             B[2 * M + n] = byy;
-            B[3 * M + n] = scale * (1 + r[3 * M + n]) * K.coeff(n, n);
+            B[3 * M + n] = scale * (1 + r[3 * M + n]) * K.coeff(2 * N + n, 2 * N + n);
           }
         }
         A.set_bottom_block(B);  // (zero on constrained nodes)
