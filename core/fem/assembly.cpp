@@ -18,7 +18,8 @@ SparseMatrix assemble_stiffness(const ElasticityOperator& op) {
   std::vector<char> fixed(static_cast<std::size_t>(N));
   for (index iz = 0; iz < g.nz(); ++iz)
     for (index iy = 0; iy < ny; ++iy)
-      for (index ix = 0; ix < nx; ++ix) fixed[std::size_t(g.node(ix, iy, iz))] = node_constrained(g, op.faces(), ix, iy, iz);
+      for (index ix = 0; ix < nx; ++ix)
+        fixed[std::size_t(g.node(ix, iy, iz))] = node_constrained(g, op.faces(), ix, iy, iz);
   index off[27];  // neighbour d = 9 (dz + 1) + 3 (dy + 1) + dx + 1 at node offset off[d], increasing
   for (int d = 0; d < 27; ++d) off[d] = (d % 3 - 1) + nx * ((d / 3) % 3 - 1) + nx * ny * (d / 9 - 1);
   SparseMatrix A(3 * N, 3 * N);
