@@ -266,6 +266,24 @@ TEST(TrescaDriver, AThinPlateOfWideElementsIsWarnedAboutAndItsResidualIsTrue) {
   EXPECT_EQ(plain.out.find("wider than the body is thick"), std::string::npos) << plain.out;
 }
 
+TEST(TrescaDriver, AThinPlateWhoseStepsStopAtTheOuterLimitTightensAndConverges) {
+  // the plate above 0.0125 m thick: on the nested 16x8x2 mesh two Newton
+  // steps in a row stopped their outer CG at its iteration limit, which
+  // ended both meshes with outer_solver_failure (exit 1) before a second
+  // missed step could tighten the inner solves; a step that stops at the
+  // limit and misses now tightens at once (RESULTS.md §0zl)
+  const std::string plate = ::testing::TempDir() + "/thin_plate_0125.json";
+  {
+    std::ofstream f(plate);
+    f << R"({"mesh": {"dims": [32, 16, 4]}, "box": {"lengths": [2, 1, 0.0125]}})";
+  }
+  const CmdResult r = run("tresca --quiet --problem " + plate);
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("converged after"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(": ok\n"), std::string::npos) << r.out;  // the KKT check
+  EXPECT_NE(r.out.find("note: the Newton steps' inner solves were tightened"), std::string::npos) << r.out;
+}
+
 TEST(TrescaDriver, WithoutLoadTheBodyStaysAtRest) {
   // b~ = 0: nested iteration (and the Coulomb fixed point) once stopped with
   // "an initial iterate u0 needs force_scale" (exit 2); u = 0, lambda = 0

@@ -440,7 +440,7 @@ class NewtonSolve {
   std::optional<NewtonReason> record(int k);
   std::optional<NewtonReason> newton_step();
   std::optional<NewtonReason> take_step();
-  void check_step(const real* Sdu);
+  void check_step(const real* Sdu, bool hit_limit);
 
   const SteklovPoincare& S;
   const NewtonOptions& opt;
@@ -669,7 +669,7 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
   R.operator_applications += 1;
   if (!work.apply(S, du.data(), Sdu, inc_rtol, Edu, Edu)) return NewtonReason::inner_failure;
   r_err = std::max(r_err, accuracy);
-  check_step(Sdu);
+  check_step(Sdu, last_step_hit_limit);  // (this step's: newton_step sets it)
   // (the launches' bodies take copies of members, not `this`: a body that
   // read p through it read host memory on a GPU, RESULTS.md §0zf)
   const index np = p;
@@ -729,9 +729,14 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
 // has missed; two steps in a row that missed tighten every later inner
 // tolerance by the smaller factor they missed their targets by. (One miss
 // alone may be the step's own: a cold start's free fall over a gap leaves
-// 0.2 r_F with ν = 0.45, and the next step meets its target.) The steps of
-// ordinary runs never miss twice in a row and never tighten.
-void NewtonSolve::check_step(const real* Sdu) {
+// 0.2 r_F with ν = 0.45, and the next step meets its target.) A step whose
+// outer CG stopped at its iteration limit and missed tightens at once, by
+// its own factor: CG lost its way on S products too inexact to converge,
+// and a second such step in a row would end Newton (outer_failure) before
+// a second miss could tighten (a plate 2 x 1 x 0.0125 m of 32x16x4
+// elements did; RESULTS.md §0zl). The steps of ordinary runs never miss
+// twice in a row, never stop at the limit, and never tighten.
+void NewtonSolve::check_step(const real* Sdu, bool hit_limit) {
   const ReducedSystem::View V = L.view();
   const real *dU = du.data(), *Sk = L.known_product.data(), *rhs = L.rhs.data();
   const index np = p;
@@ -745,8 +750,9 @@ void NewtonSolve::check_step(const real* Sdu) {
   // (a factor > 1 where the step left more than a tenth of r_F, else 0)
   const real factor =
       missed > std::max(real(0.1) * step_rhs, step_target) && step_target > 0 ? missed / step_target : 0;
-  if (factor > 0 && last_missed > 0) {
-    const real tighter = std::min(work.tightening * std::min(factor, last_missed), real(1e8));
+  const real by = last_missed > 0 ? std::min(factor, last_missed) : hit_limit ? factor : 0;
+  if (factor > 0 && by > 0) {
+    const real tighter = std::min(work.tightening * by, real(1e8));
     // r's increments so far were that much less accurate than counted: its
     // error bound grows alike, so that r is refreshed before it is believed
     r_err *= tighter / work.tightening;
