@@ -299,7 +299,7 @@ void warn_about(const Command& c) {
                  c.spec.E);
   if (c.spec.nu > 0.49)
     std::fprintf(stderr,
-                 "tresca: warning: nu = %g is nearly incompressible: Q1 elements lock and the multigrid inner solver "
+                 "tresca: warning: nu = %.9g is nearly incompressible: Q1 elements lock and the multigrid inner solver "
                  "degrades (it may fail to converge)\n",
                  c.spec.nu);
   if (!c.why_double.empty()) std::fprintf(stderr, "tresca: note: %s\n", c.why_double.c_str());
@@ -445,12 +445,17 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
   const NewtonResult& N = R.newton;
   const FinalReport& F = R.report;
   const real eps = c.opt.newton.eps;
-  char last[64] = "n/a (no approximation step)";
-  if (!N.history.empty()) std::snprintf(last, sizeof last, "%.3e", N.history.back());
+  char last[64] = "n/a (no approximation step)", tolerance[32] = "n/a";
+  if (!N.history.empty()) {
+    std::snprintf(last, sizeof last, "%.3e %s", N.history.back(), N.stop == StopRule::consistent ? "N" : "(the paper's rule)");
+    std::snprintf(tolerance, sizeof tolerance, "%.1e", N.tolerance);
+  }
   if (R.coulomb()) print_coulomb(c, R);
-  std::printf("%s after %d Newton iterations (reason: %s), final |v| %s %s(tolerance %.1e)\n",
-              R.converged() ? "converged" : "NOT CONVERGED", N.iterations, R.reason().c_str(), last,
-              N.stop == StopRule::consistent ? "N " : "(the paper's rule) ", N.tolerance);
+  std::printf("%s after %d Newton iterations (reason: %s), final |v| %s (tolerance %s)\n",
+              R.converged() ? "converged" : "NOT CONVERGED", N.iterations, R.reason().c_str(), last, tolerance);
+  if (N.history.empty() && N.reason == NewtonReason::inner_failure)
+    std::printf("note: the inner solver (multigrid CG on the body's interior) did not converge for the condensed\n"
+                "      load b~, so Newton did not start: the lines below are of u = 0, with |b~| unknown\n");
   std::printf("true residual (fresh S u - b~): %.3e absolute, %.3e relative to |b| = %.3e\n", F.true_residual,
               F.true_residual_relative, F.btilde_norm);
   if (N.reason == NewtonReason::stagnation && !N.history.empty() && N.history.back() <= 1e-9 * N.history.front())

@@ -266,22 +266,33 @@ TEST(TrescaDriver, AThinPlateOfWideElementsIsWarnedAboutAndItsResidualIsTrue) {
   EXPECT_EQ(plain.out.find("wider than the body is thick"), std::string::npos) << plain.out;
 }
 
-TEST(TrescaDriver, AThinPlateWhoseStepsStopAtTheOuterLimitTightensAndConverges) {
-  // the plate above 0.0125 m thick: on the nested 16x8x2 mesh two Newton
-  // steps in a row stopped their outer CG at its iteration limit, which
-  // ended both meshes with outer_solver_failure (exit 1) before a second
-  // missed step could tighten the inner solves; a step that stops at the
-  // limit and misses now tightens at once (RESULTS.md §0zl)
-  const std::string plate = ::testing::TempDir() + "/thin_plate_0125.json";
-  {
-    std::ofstream f(plate);
-    f << R"({"mesh": {"dims": [32, 16, 4]}, "box": {"lengths": [2, 1, 0.0125]}})";
+TEST(TrescaDriver, ThinPlatesWhoseStepsAreInexactConvergeWithAVerifiedAnswer) {
+  // Two plates 2 x 1 m whose S is a small difference of large terms
+  // (RESULTS.md §0zl). 0.0125 m thick, 32x16x4 elements: on the nested
+  // 16x8x2 mesh two Newton steps in a row stopped their outer CG at its
+  // iteration limit, which ended both meshes with outer_solver_failure
+  // before a second missed step could tighten the inner solves; a step that
+  // stops at the limit and misses now tightens at once. 0.01 m thick, 64x32x4
+  // elements: Newton stopped on an r summed from its steps that had drifted
+  // 1.6e-3 N from S u - b~, and the final check failed (kkt_check_failed); a
+  // stop believed on a summed r is now checked with a fresh one.
+  const struct {
+    const char* name;
+    const char* json;
+  } plates[] = {{"thin_plate_0125", R"({"mesh": {"dims": [32, 16, 4]}, "box": {"lengths": [2, 1, 0.0125]}})"},
+                {"thin_plate_64", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.01]}})"}};
+  for (const auto& plate : plates) {
+    const std::string file = ::testing::TempDir() + "/" + plate.name + ".json";
+    {
+      std::ofstream f(file);
+      f << plate.json;
+    }
+    const CmdResult r = run("tresca --quiet --problem " + file);
+    EXPECT_EQ(r.status, 0) << plate.name << "\n" << r.out;
+    EXPECT_NE(r.out.find("converged after"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(": ok\n"), std::string::npos) << r.out;  // the KKT check
+    EXPECT_NE(r.out.find("note: the Newton steps' inner solves were tightened"), std::string::npos) << r.out;
   }
-  const CmdResult r = run("tresca --quiet --problem " + plate);
-  EXPECT_EQ(r.status, 0) << r.out;
-  EXPECT_NE(r.out.find("converged after"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find(": ok\n"), std::string::npos) << r.out;  // the KKT check
-  EXPECT_NE(r.out.find("note: the Newton steps' inner solves were tightened"), std::string::npos) << r.out;
 }
 
 TEST(TrescaDriver, WithoutLoadTheBodyStaysAtRest) {
@@ -660,8 +671,11 @@ TEST(TrescaDriver, AWarmRestartCostsAtMostTheColdStart) {
   const double cold = work("--phi 3e5"), warm = work("--phi 3e5 --initial " + csv);
   EXPECT_LE(warm, cold) << "phi 2e5 -> 3e5";
   work("--phi 3e5 --contact-csv " + csv);
+  // (0.89 of the cold start's work until the warm run's stop was checked
+  // with a fresh r, RESULTS.md §0zl: its summed r had drifted to 2.6e-5 N,
+  // and the step that takes the fresh one under eps = 1e-6 N costs 0.08)
   const double cold_near = work("--phi 3.1e5"), warm_near = work("--phi 3.1e5 --initial " + csv);
-  EXPECT_LE(warm_near, 0.9 * cold_near) << "phi 3e5 -> 3.1e5";
+  EXPECT_LE(warm_near, 0.98 * cold_near) << "phi 3e5 -> 3.1e5";
   work("--contact-csv " + csv);
   const double cold_load = work("--load-scale 2"), warm_load = work("--load-scale 2 --initial " + csv);
   EXPECT_LE(warm_load, 1.05 * cold_load) << "load 1 -> 2";
