@@ -623,7 +623,8 @@ bool NewtonSolve::measure(int k) {
 
 // the iteration's record and progress line, and whether it stops here
 std::optional<NewtonReason> NewtonSolve::record(int k) {
-  R.tolerance = tol;
+  // (a stop a fresh r confirmed to within what r resolves: that bound)
+  R.tolerance = stop_verified && vnorm > tol ? opt.residual_accuracy * fscale : tol;
   R.history.push_back(vnorm);
   R.merit.push_back(merit);
   R.inner_history.push_back(work.iterations);

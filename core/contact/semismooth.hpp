@@ -196,7 +196,8 @@ struct NewtonResult {
   std::vector<real> history;           // the stopping quantity after each approximation step (first at x0)
   std::vector<real> merit;             // |w| [N] there (the line search's merit; = history for StopRule::consistent)
   std::vector<real> step_lengths;      // alpha of each step taken (1: a full Newton step)
-  real tolerance = 0;                  // the stopping test's max(eps, rtol |·_0|)
+  real tolerance = 0;                  // the stopping test's max(eps, rtol |·_0|), or what r resolves
+                                       // (residual_accuracy |b̃|) where a fresh r confirmed a stop to that
   std::vector<long long> inner_history, outer_history;  // cumulative inner / outer CG iterations there
   std::vector<real> u, lambda, r;      // 3p, p, 3p: r = S u - b̃ (to residual_accuracy if converged)
   Field<real> body;                    // U = E u + K_ii^{-1} l_i (S.full_size()) of that r
