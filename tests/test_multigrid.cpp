@@ -213,6 +213,45 @@ TEST(CoarseSolver, SolvesKPlusEachBottomBlockLikeASparseLDLTOnBothPaths) {
     }
 }
 
+// Solvers given the same K and face share one factor of K (coarse_solver.hpp:
+// nested iteration's meshes end on the same coarsest grid); each keeps its
+// own bottom block, and a K that differs in one entry is factorised anew
+TEST(CoarseSolver, SharesTheFactorOfTheSameKAndFaceOnly) {
+  ElasticityOperator A(test::prism(8, 4, 4), kFaceX0, 2.1e9, 0.277);
+  const GridDims& g = A.grid();
+  const index M = g.nx() * g.ny();
+  const SparseMatrix K = assemble_stiffness(A);
+  const std::vector<index> face = bottom_block_dofs(g, kFaceX0);
+  const CoarseSolver::Shared before = CoarseSolver::shared_factors();
+  CoarseSolver a, b;
+  a.factor(K, face);
+  b.factor(K, face);
+  CoarseSolver::Shared now = CoarseSolver::shared_factors();
+  EXPECT_EQ(now.made - before.made, 1);
+  EXPECT_EQ(now.reused - before.reused, 1);
+  // a gets a bottom block, b keeps K alone: each solves its own
+  std::vector<real> B(4 * M, 0.0);
+  for (index n = 0; n < M; ++n) B[n] = B[2 * M + n] = B[3 * M + n] = 1e3 * K.coeff(n, n);
+  A.set_bottom_block(B);
+  a.update(assemble_bottom_block(g, A.bottom_block().to_vector()));
+  const SparseMatrix KB = assemble(A);
+  const std::vector<real> uv = test::random_vector(A.size(), 41);
+  const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(uv.data(), A.size());
+  Eigen::VectorXd xa, xb;
+  a.solve(KB * u, xa);
+  b.solve(K.selfadjointView<Eigen::Lower>() * u, xb);
+  EXPECT_LT((xa - u).norm(), 1e-13 * u.norm());
+  EXPECT_LT((xb - u).norm(), 1e-13 * u.norm());
+  // one entry of K changed (kept symmetric: the lower triangle is read)
+  SparseMatrix K2 = K;
+  K2.coeffRef(5, 5) *= 1 + 1e-15;
+  CoarseSolver c;
+  c.factor(K2, face);
+  now = CoarseSolver::shared_factors();
+  EXPECT_EQ(now.made - before.made, 2);
+  EXPECT_EQ(now.reused - before.reused, 1);
+}
+
 TEST(MultigridCG, SinglePrecisionVCycleKeepsIterationsAndAccuracy) {
   // the V-cycle in float preconditions a double CG: same iteration count (+-1)
   // and the same attainable accuracy as the double V-cycle, odd mesh included

@@ -24,9 +24,18 @@
 // refactorisation: with |F| > max_dense_face, a new B refactorises K + B
 // (AMD ordering, kept while the pattern stays) instead. Either way the
 // answer is (K + B)^-1 b to rounding.
+//
+// The factor of K (its ordering, L, D and S) is shared: solvers given the
+// same K and F, bit for bit, use one factor. Nested iteration makes each
+// mesh's two multigrids (the interior solves' and the Newton step's
+// preconditioner's) on every mesh, and at level 8 all three meshes end on
+// the same coarsest grid: 2 factorisations instead of 6 (RESULTS.md §0zl).
+// The few most recent factors are kept for the next solver (a coarser
+// mesh's multigrids are gone before the finer mesh's are made).
 #pragma once
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#include <memory>
 #include <vector>
 
 #include "core/fem/assembly.hpp"
@@ -48,20 +57,26 @@ class CoarseSolver {
   // x = (K + B)^-1 b (x may not alias b)
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
 
-  index size() const { return index(position_.size()); }
+  index size() const { return n_; }
   // whether F's Schur complement is kept dense (|F| <= max_dense_face)
   bool dense_face() const { return dense_face_; }
+  // factorisations of K this process made (dense-face path), and those a
+  // solver took from another of the same K and F instead
+  struct Shared {
+    long long made = 0, reused = 0;
+  };
+  static Shared shared_factors();
+
+  // the dense-face path's factor of K, shared (above)
+  struct FaceLastFactor;
 
  private:
   index max_dense_face_;
   bool dense_face_ = false;
+  index n_ = 0;
   SparseMatrix K_;  // (the sparse path's: K + B is refactorised from it)
-  // the dense-face path: P K P^T factorised as given, S, and S + B's factor
-  std::vector<index> position_;  // dof i's place in P K P^T
-  std::vector<index> order_;     // its inverse: the dof at place k
-  index interior_ = 0;           // |I|: F is places [interior_, size())
-  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<index>> face_last_;
-  Eigen::MatrixXd S_;
+  // the dense-face path: P K P^T's factor and S (shared), S + B's factor
+  std::shared_ptr<const FaceLastFactor> factor_;
   Eigen::LDLT<Eigen::MatrixXd> face_;
   // the sparse path's factor of K + B, and the pattern its ordering is for
   Eigen::SimplicialLDLT<SparseMatrix> whole_;
