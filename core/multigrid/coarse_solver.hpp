@@ -26,10 +26,10 @@
 // answer is (K + B)^-1 b to rounding.
 //
 // The factor of K (its ordering, L, D and S) is shared: solvers given the
-// same K and F, bit for bit, use one factor. Nested iteration makes each
-// mesh's two multigrids (the interior solves' and the Newton step's
-// preconditioner's) on every mesh, and at level 8 all three meshes end on
-// the same coarsest grid: 2 factorisations instead of 6 (RESULTS.md §0zl).
+// same K and F, bit for bit, use one factor. Nested iteration makes two
+// multigrids on every mesh (the interior solves' and the Newton step's
+// preconditioner's), and at level 8 all three meshes end on the same
+// coarsest grid: 2 factorisations instead of 6 (RESULTS.md §0zl).
 // The few most recent factors are kept for the next solver (a coarser
 // mesh's multigrids are gone before the finer mesh's are made).
 #pragma once
