@@ -449,6 +449,8 @@ class NewtonSolve {
   InnerWork work;
   NewtonResult R;
   real fscale = 1;  // |b̃|
+  // what r resolves at its tightest (Tolerances: residual_accuracy |b̃|)
+  real resolved() const { return opt.residual_accuracy * fscale; }
   real r_err = 0;   // bounds the error of the current r
   bool r_fresh = false;       // r solved from the body at this iterate (refresh), not summed from steps
   bool stop_verified = false;  // this iterate's stop, believed on a summed r, confirmed by a fresh one
@@ -595,8 +597,8 @@ bool NewtonSolve::measure(int k) {
     eta_k = forcing_term(opt, k, vnorm, k > 0 ? R.history[k - 1] : vnorm, eta, tol);
     // r must be accurate to a fraction of what the step resolves, and to
     // the full accuracy before |v̂| <= tol is believed
-    const real need = vnorm <= tol ? opt.residual_accuracy * fscale
-                                   : std::max(opt.residual_accuracy * fscale, opt.residual_fraction * eta_k * vnorm);
+    const real need = vnorm <= tol ? resolved()
+                                   : std::max(resolved(), opt.residual_fraction * eta_k * vnorm);
     // A stop believed on an r summed from the steps' S Δu is checked with a
     // fresh one: where S is much smaller than its terms (a thin plate), the
     // increments carry more error than their inner tolerance bounds and r
@@ -605,7 +607,7 @@ bool NewtonSolve::measure(int k) {
     // RESULTS.md §0zl). The fresh r confirms the stop where it agrees to
     // within what r resolves; else Newton goes on from it.
     if (verifying) {
-      stop_verified = vnorm <= std::max(tol, opt.residual_accuracy * fscale);
+      stop_verified = vnorm <= std::max(tol, resolved());
       break;
     }
     // (a refresh lowers |v̂| where r's error was most of it, and so the
@@ -624,7 +626,7 @@ bool NewtonSolve::measure(int k) {
 // the iteration's record and progress line, and whether it stops here
 std::optional<NewtonReason> NewtonSolve::record(int k) {
   // (a stop a fresh r confirmed to within what r resolves: that bound)
-  R.tolerance = stop_verified && vnorm > tol ? opt.residual_accuracy * fscale : tol;
+  R.tolerance = stop_verified && vnorm > tol ? resolved() : tol;
   R.history.push_back(vnorm);
   R.merit.push_back(merit);
   R.inner_history.push_back(work.iterations);
@@ -681,7 +683,7 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
   axpy(n3, 1, L.known.data(), du.data());
   real* Sdu = side.data();
   real* Edu = side.data() + n3;
-  const real accuracy = std::max(opt.residual_accuracy * fscale, opt.residual_fraction * eta * vnorm);
+  const real accuracy = std::max(resolved(), opt.residual_fraction * eta * vnorm);
   // |S Δu| from the CG's side product, or (GMRES) bounded by max s |Δu|
   const real sdu_norm = L.coupled ? smax * std::sqrt(S.sum(dot(n3, du.data(), du.data())))
                                   : std::sqrt(S.sum(dot(n3, Sdu, Sdu)));
@@ -772,7 +774,7 @@ void NewtonSolve::check_step(const real* Sdu, bool hit_limit) {
   const real factor =
       missed > std::max(real(0.1) * step_rhs, step_target) && step_target > 0 ? missed / step_target : 0;
   const real by = last_missed > 0 ? std::min(factor, last_missed) : hit_limit ? factor : 0;
-  if (factor > 0 && by > 0) {
+  if (by > 0) {
     const real tighter = std::min(work.tightening * by, real(1e8));
     // r's increments so far were that much less accurate than counted: its
     // error bound grows alike, so that r is refreshed before it is believed
