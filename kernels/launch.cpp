@@ -260,12 +260,21 @@ struct Guard {
   bool on = false;
   int open = 0, launches = 0;  // nesting depth of the regions, and of the launches among them, running now
   std::unique_ptr<Arena> device, host;
+  std::uintptr_t heap_begin = 0;  // where malloc's main heap starts (its end: sbrk(0))
   Guard() {
     const char* e = std::getenv("TRESCA_DEVICE_GUARD");
     on = e && std::string(e) == "1" && omp_get_num_devices() == 0;
     if (!on) return;
     device = std::make_unique<Arena>(PROT_NONE);
     host = std::make_unique<Arena>(PROT_READ | PROT_WRITE);
+    heap_begin = std::uintptr_t(sbrk(0));
+    if (FILE* f = std::fopen("/proc/self/maps", "r")) {
+      char line[512];
+      unsigned long a = 0, b = 0;
+      while (std::fgets(line, sizeof line, f))
+        if (std::strstr(line, "[heap]") && std::sscanf(line, "%lx-%lx", &a, &b) == 2) heap_begin = a;
+      std::fclose(f);
+    }
   }
 };
 Guard& guard() {
@@ -497,6 +506,26 @@ void space_zero(Space s, void* p, std::size_t bytes) {
 }
 
 bool device_guarded() { return guard().on; }
+
+// Where the guard cannot close what a body reads (a std::vector's data is
+// not a Field), it reads the body: every 8-byte-aligned word is compared
+// with malloc's main heap, where small host arrays live. (A closure's
+// padding may hold stale stack or library addresses, so only the heap's
+// range is asked about.)
+void detail::check_device_body(const char* kernel, const void* body, std::size_t bytes) {
+  const Guard& g = guard();
+  if (!g.on) return;
+  const std::uintptr_t end = std::uintptr_t(sbrk(0));
+  const unsigned char* b = static_cast<const unsigned char*>(body);
+  for (std::size_t k = 0; k + sizeof(std::uintptr_t) <= bytes; k += sizeof(std::uintptr_t)) {
+    std::uintptr_t w;
+    std::memcpy(&w, b + k, sizeof w);
+    if (w % alignof(std::max_align_t) == 0 && w >= g.heap_begin && w < end)
+      throw std::logic_error(std::string("device guard: the device launch '") + kernel +
+                             "' was given an address in the host's heap (a host array that is not a Field), "
+                             "which a GPU cannot read");
+  }
+}
 
 DeviceRegion::DeviceRegion(bool copy) : copy_(copy) {
   Guard& g = guard();

@@ -340,6 +340,11 @@ inline void for_row_share(index n1, index n0, index t, index w, const Body& body
 // One copy per translation unit (internal linkage), in its own device image
 // (a program's and libtresca_launch.so's are images apart, CMakeLists.txt).
 namespace detail {
+// under the device guard (TRESCA_DEVICE_GUARD=1), std::logic_error where a
+// device launch's body holds an address in the host's malloc heap (a
+// std::vector's or an Eigen vector's data: an illegal address on a GPU,
+// which the host fallback reads without complaint)
+void check_device_body(const char* kernel, const void* body, std::size_t bytes);
 constexpr std::size_t kDeviceBodyBytes = 512;
 constexpr int kDeviceArgSizes = 4;
 struct DeviceArgs {
@@ -354,10 +359,12 @@ static detail::DeviceArgs tresca_device_args;
 namespace detail {
 // sends a launch's ranges, scratch and body to the device
 template <class Body>
-inline void send_to_device(const Body& body, std::initializer_list<index> sizes, void* pool = nullptr) {
+inline void send_to_device(const char* kernel, const Body& body, std::initializer_list<index> sizes,
+                           void* pool = nullptr) {
   static_assert(std::is_trivially_copyable<Body>::value, "a device body holds device pointers and scalars");
   static_assert(sizeof(Body) <= kDeviceBodyBytes, "a device body larger than kDeviceBodyBytes");
   TRESCA_ASSERT(sizes.size() <= std::size_t(kDeviceArgSizes));
+  check_device_body(kernel, &body, sizeof(Body));
   std::copy(sizes.begin(), sizes.end(), tresca_device_args.n);
   tresca_device_args.pool = pool;
   std::memcpy(tresca_device_args.body, &body, sizeof(Body));
@@ -374,7 +381,7 @@ template <class Body>
 inline void device_entries(const char* kernel, index n, Cost per_entry, const Body& body) {
   const DeviceLaunch launch(kernel, double(n) * per_entry);
   DeviceRegion region;
-  send_to_device(body, {n});
+  send_to_device(kernel, body, {n});
 #pragma omp target teams distribute parallel for simd thread_limit(kDeviceWarps)
   for (index i = 0; i < tresca_device_args.n[0]; ++i) sent_body<Body>()(i);
 }
@@ -444,7 +451,7 @@ inline void for_each_block(const char* kernel, index n, Cost work, const Body& b
   if (launch_on_device()) {
     const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
-    detail::send_to_device(body, {n});
+    detail::send_to_device(kernel, body, {n});
 #pragma omp target teams distribute parallel for thread_limit(kDeviceWarps)
     for (index i = 0; i < tresca_device_args.n[0]; ++i) detail::sent_body<Body>()(i);
     return;
@@ -460,7 +467,7 @@ inline void for_each_block(const char* kernel, index n1, index n0, Cost work, co
   if (launch_on_device()) {  // one block per (team) thread; the body's own `omp simd` loops in its lanes
     const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
-    detail::send_to_device(body, {n1, n0});
+    detail::send_to_device(kernel, body, {n1, n0});
     if (device_rows_interleaved()) {
 #pragma omp target teams distribute parallel for collapse(2) thread_limit(kDeviceWarps) schedule(static, 1)
       for (index j = 0; j < tresca_device_args.n[0]; ++j)
@@ -495,7 +502,7 @@ inline void for_each_block_with_scratch(const char* kernel, index n2, index n1, 
     void* pool = device_scratch(Scratch::blocks, std::size_t(kScratchTeams) * kDeviceWarps * scratch * sizeof(T));
     DeviceRegion region;
     // (the sizes, then each worker's slice of the pool: `scratch` entries)
-    detail::send_to_device(body, {n2, n1, n0, scratch}, pool);
+    detail::send_to_device(kernel, body, {n2, n1, n0, scratch}, pool);
 #pragma omp target teams distribute parallel for collapse(3) num_teams(kScratchTeams) thread_limit(kDeviceWarps)
     for (index c = 0; c < tresca_device_args.n[0]; ++c)
       for (index j = 0; j < tresca_device_args.n[1]; ++j)
@@ -543,7 +550,7 @@ inline real sum_over_blocks(const char* kernel, index n, index width, Cost per_e
     void* sums = device_scratch(Scratch::sums, std::size_t(nb) * sizeof(real));
     {
       DeviceRegion region;
-      detail::send_to_device(entry, {n, width, nb}, sums);
+      detail::send_to_device(kernel, entry, {n, width, nb}, sums);
       if (device_warp_sums()) {  // a warp a block, its entries across the lanes
 #pragma omp target teams distribute parallel for thread_limit(kDeviceWarps)
         for (index b = 0; b < tresca_device_args.n[2]; ++b) {

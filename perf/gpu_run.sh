@@ -187,6 +187,12 @@ if [[ $stage == tests || $stage == all ]]; then
   sanitizer=$(command -v compute-sanitizer || ls /usr/local/cuda/bin/compute-sanitizer 2>/dev/null || true)
   failed=$(sed -nE 's/^\[  FAILED  \] (Device[A-Za-z]*\.[A-Za-z]+) \(.*/\1/p' "$out/test_device.log" |
            grep -v PresentWhereRequired | paste -sd: || true)
+  # a test that ended the program (libgomp exits on an illegal address, so
+  # gtest never writes FAILED): the last one started
+  if [[ -z $failed && $rc != 0 ]]; then
+    failed=$(sed -nE 's/^\[ RUN      \] (Device[A-Za-z]*\.[A-Za-z]+)$/\1/p' "$out/test_device.log" | tail -1)
+    [[ -z $failed ]] || echo "== $failed ended the program (exit status $rc)"
+  fi
   if [[ -n $failed && -n $sanitizer ]] && nvidia-smi > /dev/null 2>&1; then
     echo "== compute-sanitizer --tool memcheck on $failed"
     timeout -k 5 ${SANITIZER_SECONDS:-90} "$sanitizer" --tool memcheck --print-limit 12 "$bin/test_device" \

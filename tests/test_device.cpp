@@ -236,6 +236,28 @@ TEST(DeviceGuard, StopsAKernelReadOfHostMemory) {
   EXPECT_DEATH(copy(3, host.data(), y.data()), "");
 }
 
+// ... and so does a kernel given a host array that is not a Field (a
+// std::vector's data: the guard cannot close malloc's heap, so it reads
+// the launch's body for an address there; found on an H200, where the
+// Coulomb fixed point's Anderson sums ran the device's dot over its host
+// vectors, RESULTS.md §0zm)
+TEST(DeviceGuard, StopsAKernelGivenAHostArray) {
+  const char* e = std::getenv("TRESCA_DEVICE_GUARD");
+  if (!e || std::string(e) != "1") GTEST_SKIP() << "TRESCA_DEVICE_GUARD unset";
+  if (omp_get_num_devices() > 0) GTEST_SKIP() << "a GPU is present: its memory guards itself";
+  if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device launches";
+  const std::vector<real> host{1, 2, 3};
+  OnDevice on;
+  const Field<real> x = on_device({1, 2, 3});
+  EXPECT_EQ(dot(3, x.data(), x.data()), 14);
+  EXPECT_THROW(dot(3, host.data(), x.data()), std::logic_error);
+  EXPECT_THROW(dot(3, x.data(), host.data()), std::logic_error);
+  {
+    const HostLaunches on_the_host;  // (where host arrays belong)
+    EXPECT_EQ(dot(3, host.data(), host.data()), 14);
+  }
+}
+
 TEST(Device, VectorKernelsOnTheDeviceMatchTheHost) {
   if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device backend to test";
   std::printf("device: %s\n", device_description().c_str());

@@ -87,6 +87,7 @@ CoulombResult coulomb_fixed_point(const SteklovPoincare& S, ContactConditions la
     law.phi = G;
     const int k = int(dF.size());
     if (k > 0) {
+      const HostLaunches host;  // (its differences are host vectors, also in a device run)
       Eigen::MatrixXd A(k, k);
       Eigen::VectorXd rhs(k);
       for (int a = 0; a < k; ++a) {
