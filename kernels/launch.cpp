@@ -507,6 +507,7 @@ void space_zero(Space s, void* p, std::size_t bytes) {
 
 bool device_guarded() { return guard().on; }
 
+#ifdef TRESCA_OFFLOAD
 // Where the guard cannot close what a body reads (a std::vector's data is
 // not a Field), it reads the body: every 8-byte-aligned word is compared
 // with malloc's main heap, where small host arrays live. (A closure's
@@ -526,6 +527,7 @@ void detail::check_device_body(const char* kernel, const void* body, std::size_t
                              "which a GPU cannot read");
   }
 }
+#endif
 
 DeviceRegion::DeviceRegion(bool copy) : copy_(copy) {
   Guard& g = guard();
