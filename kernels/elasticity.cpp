@@ -195,22 +195,22 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
   const index nz = rows.z_end - rows.z_begin, nyr = rows.y_end - rows.y_begin;
   const double nodes = double(nx) * double(nz) * double(nyr);
   const char* name = precision_name<T>("apply", "apply (float)");  // (the banded apply's device form)
-  // Two choices of form (launch.hpp), neither of which changes the order
-  // of a node's sum, which takes its groups as they are stored:
-  //  - P groups a pass (device_apply_groups()): a lane issues the loads of
-  //    P groups before their multiply-adds, in one block of code that ptxas
-  //    may schedule as a whole;
-  //  - U nodes a lane (device_lane_nodes()): a lane computes U nodes of the
-  //    run at once, S apart (for each of them the warp's lanes read
-  //    neighbouring entries), and loads each group's offset and
-  //    coefficients once for the U: U times the independent loads in
-  //    flight, a U-th of the group loads. A run shorter than U warps (the
-  //    one-node runs at a row's ends) is swept a node a lane; where U*S
-  //    passes the run's end, a lane computes its first node again and
-  //    stores nothing for the others.
-  auto sweep = [&](auto kind, auto pass, auto lane) {
+  // Its form (measured on an H200 against 3 groups a pass, a node a lane
+  // and rows in runs: RESULTS.md §0zh, §0zi, §0zm), which keeps the order of
+  // a node's sum, its groups as they are stored:
+  //  - P groups a pass: a lane issues the loads of P groups before their
+  //    multiply-adds, in one block of code that ptxas may schedule as a
+  //    whole;
+  //  - U nodes a lane: a lane computes U nodes of the run at once, S apart
+  //    (for each of them the warp's lanes read neighbouring entries), and
+  //    loads each group's offset and coefficients once for the U: U times
+  //    the independent loads in flight, a U-th of the group loads. A run
+  //    shorter than U warps (the one-node runs at a row's ends) is swept a
+  //    node a lane; where U*S passes the run's end, a lane computes its
+  //    first node again and stores nothing for the others.
+  constexpr int P = 9, U = 4;
+  with_kind(out, [&](auto kind) {
     constexpr OutKind K = decltype(kind)::value;
-    constexpr int P = decltype(pass)::value, U = decltype(lane)::value;
     for_each_block(name, nz, nyr, nodes * in_precision<T>(apply_cost(out)), [=](index jz, index jy) {
       sweep_row<K>(k, nx, ny, N, z0 + jz, y0 + jy, x, out,
                    [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
@@ -252,19 +252,10 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
                        }
                      };
                      constexpr index kLanes = 32;  // a warp's (GCC's simd width on the GPU)
-                     if (U > 1 && i1 - i0 >= kLanes * U) return nodes_a_lane(lane);
+                     if (i1 - i0 >= kLanes * U) return nodes_a_lane(std::integral_constant<int, U>{});
                      nodes_a_lane(std::integral_constant<int, 1>{});
                    });
     });
-  };
-  using std::integral_constant;
-  with_kind(out, [&](auto kind) {
-    auto with_groups = [&](auto lane) {
-      if (device_apply_groups() == 3) return sweep(kind, integral_constant<int, 3>{}, lane);
-      sweep(kind, integral_constant<int, 9>{}, lane);
-    };
-    if (device_lane_nodes() == 4) return with_groups(integral_constant<int, 4>{});
-    with_groups(integral_constant<int, 1>{});
   });
 }
 

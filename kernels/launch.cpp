@@ -131,9 +131,6 @@ void set_launch_on_device(bool on) {
   if (on) {  // a bad TRESCA_DEVICE_* setting stops here, before any launch
     device_warps();
     device_min_nodes();
-    device_apply_groups();
-    device_lane_nodes();
-    device_rows_interleaved();
     device_warp_sums();
   }
   on_device = on;
@@ -183,21 +180,6 @@ index device_min_nodes() {
   static const index nodes = index(setting("TRESCA_DEVICE_MIN_NODES", 32768, 0,
                                            std::numeric_limits<long long>::max(), "a node count >= 0"));
   return nodes;
-}
-
-int device_apply_groups() {
-  static const int groups = one_of("TRESCA_DEVICE_GROUPS", 9, 3, 9);
-  return groups;
-}
-
-int device_lane_nodes() {
-  static const int nodes = one_of("TRESCA_DEVICE_LANE_NODES", 4, 1, 4);
-  return nodes;
-}
-
-bool device_rows_interleaved() {
-  static const bool on = one_of("TRESCA_DEVICE_INTERLEAVE", 1, 0, 1) == 1;
-  return on;
 }
 
 bool device_warp_sums() {
@@ -601,11 +583,7 @@ std::string device_description() {
   const int n = omp_get_num_devices();
   const std::string teams = ", " + std::to_string(kDeviceWarps) +
                             " warps a team, multigrid levels and coarser meshes under " +
-                            std::to_string(device_min_nodes()) + " nodes on the host, the apply " +
-                            std::to_string(device_apply_groups()) + " groups a pass and " +
-                            std::to_string(device_lane_nodes()) + (device_lane_nodes() == 1 ? " node" : " nodes") +
-                            " a lane, rows " +
-                            (device_rows_interleaved() ? "interleaved" : "in runs") + ", sums a block a " +
+                            std::to_string(device_min_nodes()) + " nodes on the host, sums a block a " +
                             (device_warp_sums() ? "warp" : "team");
   if (n == 0) return "none: target regions run on the host" + teams;
   const DeviceInfo info = device_info();

@@ -45,10 +45,9 @@ namespace tresca {
 bool launch_on_device();
 void set_launch_on_device(bool on);  // throws std::invalid_argument if the build has no offload
 bool offload_built();                // whether this build has TRESCA_OFFLOAD
-// "device 0 of 1 (OpenMP offload: NVIDIA H100 80GB HBM3, 85.0 GB), 8 warps
-// a team, multigrid levels and coarser meshes under 32768 nodes on the
-// host, the apply 9 groups a pass and 4 nodes a lane, rows interleaved,
-// sums a block a warp",
+// "device 0 of 1 (OpenMP offload: NVIDIA H200, 150.1 GB), 8 warps a team,
+// multigrid levels and coarser meshes under 32768 nodes on the host, sums
+// a block a warp",
 // "none: target regions run on the host, 8 warps a team, ..." or "none
 // (built without offload)"
 std::string device_description();
@@ -79,11 +78,27 @@ DeviceInfo device_info();
 // §0zg). device_warps() is that value; it throws std::invalid_argument
 // where the environment's TRESCA_DEVICE_WARPS asks for another (or for a
 // count outside 1..32).
+//
+// With the default the regions name no team size at all (TRESCA_TEAM_SIZE
+// is empty) and libgomp's nvptx plugin starts its own 8 warps a team (read
+// in its binary: a thread count <= 0 becomes 8): the same teams. Any
+// thread_limit clause makes GOMP_teams4, in every team on the device,
+// allocate a task for its ICVs with the device's malloc and free it at the
+// end (libgomp's nvptx PTX: gomp_new_icv), and on an H200 every launch then
+// cost about 4 us a team, serialised: 1.3 ms for the vector kernels' 396
+// teams, 0.8 ms for the apply's 132, 12 ms for 3168 teams of one warp
+// (RESULTS.md §0zm; the same teams without a clause: to be measured,
+// `run.sh launch`).
 #ifndef TRESCA_DEVICE_WARPS
 #define TRESCA_DEVICE_WARPS 8
 #endif
 constexpr int kDeviceWarps = TRESCA_DEVICE_WARPS;
 static_assert(kDeviceWarps >= 1 && kDeviceWarps <= 32, "TRESCA_DEVICE_WARPS: a warp count in 1..32");
+#if TRESCA_DEVICE_WARPS == 8
+#define TRESCA_TEAM_SIZE
+#else
+#define TRESCA_TEAM_SIZE thread_limit(TRESCA_DEVICE_WARPS)
+#endif
 int device_warps();
 
 // In a device run, the multigrid levels (the finest aside) and the nested
@@ -97,34 +112,15 @@ int device_warps();
 // only; default 32768. Throws std::invalid_argument for any other value.
 index device_min_nodes();
 
-// Three choices in the device form of the stencil apply, open at run time
-// as an A/B for the test machine until it has measured them (perf/RESULTS.md
-// §0zh, §0zi); each changes only the order in which work is done, not the
-// order of any sum's terms: the same answers to rounding (the host
-// fallback's compiled code differs in the last bits of a few entries near
-// zero). Read once; std::invalid_argument for any other value.
-//  - device_apply_groups(): stencil groups a lane loads at once before it
-//    multiplies (TRESCA_DEVICE_GROUPS, 3 or 9; default 9): more loads in
-//    flight a lane, more registers (perf/offload_registers.py);
-//  - device_lane_nodes(): nodes of a run a lane computes at once
-//    (TRESCA_DEVICE_LANE_NODES, 1 or 4; default 4): with 4, each group's
-//    offset and coefficients are loaded once for 4 nodes, and 4 times the
-//    independent loads are in flight (runs of 128 nodes and more);
-//  - device_rows_interleaved(): how a team's warps share its rows in a
-//    launch over a plane's rows (for_each_block over n1 x n0 blocks;
-//    TRESCA_DEVICE_INTERLEAVE, 0 or 1; default 1): 0, each warp a
-//    contiguous run of the team's rows (OpenMP's static schedule); 1, the
-//    warps take consecutive rows in turn, so that at any time they sweep
-//    neighbouring rows whose inputs overlap in the multiprocessor's cache.
-int device_apply_groups();
-int device_lane_nodes();
-bool device_rows_interleaved();
-// A fourth such choice, in the device form of the deterministic sums
-// (sum_over_blocks: dot products, the fused CG updates): a block of 4096
-// entries summed by one warp across its lanes (TRESCA_DEVICE_WARP_SUMS=1,
-// the default), or by a team, which opens a parallel region for each block
-// and combines its warps' sums (0). Each block's sum is fixed by the
-// choice, whatever the number of teams; the two differ in rounding.
+// A choice in the device form of the deterministic sums, open at run time
+// as an A/B for the test machine until it has measured it (perf/RESULTS.md
+// §0zh; the apply's choices were settled in §0zm): in sum_over_blocks (dot
+// products, the fused CG updates) a block of 4096 entries summed by one
+// warp across its lanes (TRESCA_DEVICE_WARP_SUMS=1, the default), or by a
+// team, which opens a parallel region for each block and combines its
+// warps' sums (0). Each block's sum is fixed by the choice, whatever the
+// number of teams; the two differ in rounding. Read once;
+// std::invalid_argument for any other value.
 bool device_warp_sums();
 
 // Launches (and new Fields) are the host's inside this scope, and where
@@ -382,7 +378,7 @@ inline void device_entries(const char* kernel, index n, Cost per_entry, const Bo
   const DeviceLaunch launch(kernel, double(n) * per_entry);
   DeviceRegion region;
   send_to_device(kernel, body, {n});
-#pragma omp target teams distribute parallel for simd thread_limit(kDeviceWarps)
+#pragma omp target teams distribute parallel for simd TRESCA_TEAM_SIZE
   for (index i = 0; i < tresca_device_args.n[0]; ++i) sent_body<Body>()(i);
 }
 }  // namespace detail
@@ -452,7 +448,7 @@ inline void for_each_block(const char* kernel, index n, Cost work, const Body& b
     const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
     detail::send_to_device(kernel, body, {n});
-#pragma omp target teams distribute parallel for thread_limit(kDeviceWarps)
+#pragma omp target teams distribute parallel for TRESCA_TEAM_SIZE
     for (index i = 0; i < tresca_device_args.n[0]; ++i) detail::sent_body<Body>()(i);
     return;
   }
@@ -468,15 +464,13 @@ inline void for_each_block(const char* kernel, index n1, index n0, Cost work, co
     const detail::DeviceLaunch launch(kernel, work);
     DeviceRegion region;
     detail::send_to_device(kernel, body, {n1, n0});
-    if (device_rows_interleaved()) {
-#pragma omp target teams distribute parallel for collapse(2) thread_limit(kDeviceWarps) schedule(static, 1)
-      for (index j = 0; j < tresca_device_args.n[0]; ++j)
-        for (index i = 0; i < tresca_device_args.n[1]; ++i) detail::sent_body<Body>()(j, i);
-    } else {
-#pragma omp target teams distribute parallel for collapse(2) thread_limit(kDeviceWarps)
-      for (index j = 0; j < tresca_device_args.n[0]; ++j)
-        for (index i = 0; i < tresca_device_args.n[1]; ++i) detail::sent_body<Body>()(j, i);
-    }
+    // a team's warps take its rows in turn, so that at any time they sweep
+    // neighbouring rows, whose inputs overlap in the multiprocessor's cache
+    // (1.35x the apply's speed of contiguous runs a warp on an H200,
+    // RESULTS.md §0zm)
+#pragma omp target teams distribute parallel for collapse(2) TRESCA_TEAM_SIZE schedule(static, 1)
+    for (index j = 0; j < tresca_device_args.n[0]; ++j)
+      for (index i = 0; i < tresca_device_args.n[1]; ++i) detail::sent_body<Body>()(j, i);
     return;
   }
 #endif
@@ -503,7 +497,7 @@ inline void for_each_block_with_scratch(const char* kernel, index n2, index n1, 
     DeviceRegion region;
     // (the sizes, then each worker's slice of the pool: `scratch` entries)
     detail::send_to_device(kernel, body, {n2, n1, n0, scratch}, pool);
-#pragma omp target teams distribute parallel for collapse(3) num_teams(kScratchTeams) thread_limit(kDeviceWarps)
+#pragma omp target teams distribute parallel for collapse(3) num_teams(kScratchTeams) TRESCA_TEAM_SIZE
     for (index c = 0; c < tresca_device_args.n[0]; ++c)
       for (index j = 0; j < tresca_device_args.n[1]; ++j)
         for (index i = 0; i < tresca_device_args.n[2]; ++i)
@@ -552,7 +546,7 @@ inline real sum_over_blocks(const char* kernel, index n, index width, Cost per_e
       DeviceRegion region;
       detail::send_to_device(kernel, entry, {n, width, nb}, sums);
       if (device_warp_sums()) {  // a warp a block, its entries across the lanes
-#pragma omp target teams distribute parallel for thread_limit(kDeviceWarps)
+#pragma omp target teams distribute parallel for TRESCA_TEAM_SIZE
         for (index b = 0; b < tresca_device_args.n[2]; ++b) {
           const index all = tresca_device_args.n[0], w = tresca_device_args.n[1];
           const index i1 = b + 1 < tresca_device_args.n[2] ? (b + 1) * w : all;
@@ -563,7 +557,7 @@ inline real sum_over_blocks(const char* kernel, index n, index width, Cost per_e
           static_cast<real*>(tresca_device_args.pool)[b] = s;
         }
       } else {  // a team a block, its entries across the team's warps and lanes
-#pragma omp target teams distribute thread_limit(kDeviceWarps)
+#pragma omp target teams distribute TRESCA_TEAM_SIZE
         for (index b = 0; b < tresca_device_args.n[2]; ++b) {
           const index all = tresca_device_args.n[0], w = tresca_device_args.n[1];
           const index i1 = b + 1 < tresca_device_args.n[2] ? (b + 1) * w : all;

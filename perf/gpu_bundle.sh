@@ -26,7 +26,7 @@ configure=(-DCMAKE_BUILD_TYPE=Release -DTRESCA_OFFLOAD=ON -DCMAKE_CXX_COMPILER=g
            -DTRESCA_MPI=OFF -DTRESCA_NATIVE=OFF -DTRESCA_ARCH=x86-64-v3)
 mkdir -p "$build"
 cmake -S . -B "$build" "${configure[@]}" > "$build/configure.log"
-cmake --build "$build" -j "$(nproc)" --target test_device bench_kernels tresca elastic roofline device_code_fixture > "$build/build.log"
+cmake --build "$build" -j "$(nproc)" --target test_device bench_kernels tresca elastic roofline device_code_fixture launch_probe > "$build/build.log"
 # bench_kernels once more with the vector kernels in the program's device
 # image (TRESCA_LAUNCH_LIBRARY=STATIC), for run.sh images
 one="$build-one-image"
@@ -36,7 +36,7 @@ cmake --build "$one" -j "$(nproc)" --target bench_kernels > "$one/build.log"
 rm -rf "$out"
 mkdir -p "$out/lib"
 cp "$build"/bin/test_device "$build"/bin/bench_kernels "$build"/bin/tresca "$build"/bin/elastic "$build"/bin/roofline \
-   "$build"/bin/device_code_fixture "$out"/
+   "$build"/bin/device_code_fixture "$build"/bin/launch_probe "$out"/
 cp "$build"/lib/libtresca_launch.so "$out/lib/"  # (the vector kernels' device image, CMakeLists.txt)
 mkdir -p "$out/one-image"
 cp "$one"/bin/bench_kernels "$out/one-image/"

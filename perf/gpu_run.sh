@@ -5,7 +5,8 @@
 #   run.sh first    one call for a session with the 15-minute lease, the
 #                   most decisive first, each step under a timeout and all
 #                   of them within FIRST_BUDGET seconds (default 420): tests,
-#                   the level-13 apply, V-cycle and vector benchmarks,
+#                   what a launch costs (launch), the level-13 apply, V-cycle
+#                   and vector benchmarks,
 #                   contact (levels 8 and 12, Coulomb), level 14 on the GPU,
 #                   the kernels' forms, roofline, level 15, why; then a summary of the lines that
 #                   answer issue 22's bars (where the device tests find no
@@ -16,8 +17,13 @@
 #                   tests/device_code_fixture.cpp, GCC 12's miscompiled
 #                   pattern (its line says WRONG on a GPU); a device test
 #                   that fails on a GPU runs again under compute-sanitizer,
-#                   and with the kernels' earlier forms (where it passes
-#                   so, `first` runs its other steps with those)
+#                   and with the sums' other form (where it passes so,
+#                   `first` runs its other steps with that)
+#   run.sh launch   what each form of an OpenMP target region costs with
+#                   this libgomp, apart from our kernels (launch_probe: an
+#                   empty region, an axpy of 1024 and of VEC_SIZE entries;
+#                   RESULTS.md §0zm), and the teams and warps libgomp gives
+#                   each (GOMP_DEBUG=1)
 #   run.sh bench    the Device* benchmarks (BENCH=regex) and roofline
 #                   --device gpu at level 13 (DeviceAxpy/1024 and
 #                   DeviceDot/1024: what one launch costs)
@@ -27,13 +33,11 @@
 #                   within 1e-10 of each column's largest, same contact and
 #                   stick sets, same Newton and Krylov iterations (issue 22)
 #   run.sh large    tresca --device gpu at levels 13, 14 and 15
-#   run.sh forms    the device kernels' forms (kernels/launch.hpp), in
-#                   alternating rounds: the level-13 apply in double and
-#                   float and the V-cycle under five of the forms that
-#                   TRESCA_DEVICE_GROUPS (3, 9), TRESCA_DEVICE_LANE_NODES
-#                   (1, 4) and TRESCA_DEVICE_INTERLEAVE (0, 1) make; the dot
-#                   and the CG update at 2^27 entries under
-#                   TRESCA_DEVICE_WARP_SUMS 1 or 0 (RESULTS.md §0zh, §0zi)
+#   run.sh forms    the device sums' two forms (kernels/launch.hpp), in
+#                   alternating rounds: the dot and the CG update at 2^27
+#                   entries under TRESCA_DEVICE_WARP_SUMS 1 or 0 (a block a
+#                   warp or a team; RESULTS.md §0zh; the apply's forms were
+#                   settled in §0zm)
 #   run.sh warps    the team size (a build setting, TRESCA_DEVICE_WARPS: the
 #                   bundle's and each warps-N/ that gpu_bundle.sh built with
 #                   BUNDLE_WARPS="N ..."): the level-13 apply, V-cycle and
@@ -73,7 +77,7 @@ bin=${TRESCA_BIN:-$here}
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export OMP_TARGET_OFFLOAD=${OMP_TARGET_OFFLOAD:-MANDATORY} TRESCA_REQUIRE_DEVICE=${TRESCA_REQUIRE_DEVICE:-1}
 stage=${1:-all}
-stages="first tests bench elastic contact large forms warps cut images why all"
+stages="first tests launch bench elastic contact large forms warps cut images why all"
 if [[ " $stages " != *" $stage "* ]]; then
   echo "run.sh: unknown stage '$stage' (${stages// /, })" >&2
   exit 2
@@ -102,9 +106,9 @@ if [[ -z ${RUN_SH_NESTED:-} ]]; then
   echo "# run.sh $stage, $(date -u '+%F %H:%M UTC'); $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) CPUs"
   nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader 2>/dev/null || echo "no nvidia-smi"
 fi
-# the device kernels' forms before §0zh (kernels/launch.hpp): the fallback
-# of `first` where the defaults fail a device test that these pass
-earlier_forms="TRESCA_DEVICE_GROUPS=3 TRESCA_DEVICE_LANE_NODES=1 TRESCA_DEVICE_INTERLEAVE=0 TRESCA_DEVICE_WARP_SUMS=0"
+# the device sums' other form (kernels/launch.hpp): the fallback of `first`
+# where the default fails a device test that this passes
+earlier_forms="TRESCA_DEVICE_WARP_SUMS=0"
 bench() {  # a benchmark filter
   "$bin/bench_kernels" --benchmark_filter="$1" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
     "${bench_args[@]}"
@@ -152,6 +156,7 @@ if [[ $stage == first ]]; then
     # shellcheck disable=SC2086 # (its assignments, split on purpose)
     export $earlier_forms
   fi
+  step 40 15 2-launch launch
   step 120 30 2-bench bench BENCH="Device(Apply|ApplyFloat|VCycle|RestrictProlong)/$L/|Device(Dot|Axpy|CgUpdate)/$V/|Device(Axpy|Dot)/1024/" NO_ROOFLINE=1
   step 150 60 3-contact contact
   step 90 30 4-large large LARGE_LEVELS="${FIRST_LARGE:-14}"
@@ -260,18 +265,15 @@ if [[ $stage == images ]]; then
     done
   done
 fi
+if [[ $stage == launch ]]; then
+  "$bin/launch_probe" "$V"
+  echo "== launch: the teams and warps libgomp gives each region (GOMP_DEBUG=1; its calls, the region)"
+  GOMP_DEBUG=1 "$bin/launch_probe" 1024 2>&1 | sed -nE 's/.*kernel ([^:]*): launch (.*)/\1 \2/p' |
+    sed -E 's/_ZN12_GLOBAL__N_1//' | sort | uniq -c | sort -rn | head -20
+fi
 if [[ $stage == forms ]]; then
   mkdir -p "$out"
   for round in $(seq "${FORMS_ROUNDS:-2}"); do
-    # groups a pass, nodes a lane, rows interleaved: the default (§0zi),
-    # §0zh's, each of its choices alone, the forms before §0zh
-    for form in "9 4 1" "9 1 1" "3 4 1" "9 4 0" "3 1 0"; do
-      read -r groups lane interleave <<< "$form"
-      echo "== forms: TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_LANE_NODES=$lane" \
-        "TRESCA_DEVICE_INTERLEAVE=$interleave (round $round)"
-      TRESCA_DEVICE_GROUPS=$groups TRESCA_DEVICE_LANE_NODES=$lane TRESCA_DEVICE_INTERLEAVE=$interleave \
-        bench "Device(Apply|ApplyFloat|VCycle)/$L/"
-    done
     for sums in 1 0; do
       echo "== forms: TRESCA_DEVICE_WARP_SUMS=$sums (round $round)"
       TRESCA_DEVICE_WARP_SUMS=$sums bench "Device(Dot|CgUpdate)/$V/"

@@ -40,9 +40,20 @@ the device image's (mkoffload's list of their PTX names) must have as many
 entries, or libgomp refuses the image when it loads it on a GPU ("Cannot
 map target functions or variables"), which the host fallback never does.
 
-Exit 0 when no body uses that stack, no region maps and the tables agree;
-1 (naming what fails) otherwise. With --expect-flagged, the reverse: exit 0 only if BINARY has
-both a body on the stack and a region that maps
+Team sizes. A teams region with a thread_limit clause makes GOMP_teams4, in
+every team on the device, allocate a task for the team's ICVs with the
+device's malloc and free it at the team's end (gomp_new_icv, in libgomp's
+nvptx PTX); on an H200 a launch then cost about 4 us a team, serialised,
+1.3 ms for 396 teams (RESULTS.md §0zm). Without the clause libgomp starts 8
+warps a team, the default team size (kernels/launch.hpp: TRESCA_TEAM_SIZE).
+Every call of GOMP_teams4 in the PTX must pass 0 as its third argument,
+unless --sized-teams (a build with another TRESCA_DEVICE_WARPS, which
+needs the clause).
+
+Exit 0 when no body uses that stack, no region maps, the tables agree and no
+teams region names a size; 1 (naming what fails) otherwise. With
+--expect-flagged, the reverse: exit 0 only if BINARY has a body on the
+stack, a region that maps and a teams region that names its size
 (tests/device_code_fixture.cpp, written with both, shows that the checks
 still see them with this compiler)."""
 import os
@@ -72,6 +83,33 @@ def simt_stack_users(ptx):
         if uses:
             found.append((name, len(uses)))
     return found
+
+
+def team_sizes(ptx):
+    """the thread_limit each call of GOMP_teams4 in a PTX module passes (its
+    third argument; None where the code does not show a constant)"""
+    sizes = []
+    for part in re.split(r"\n// BEGIN ", ptx):
+        lines = part.split("\n")
+        for k, line in enumerate(lines):
+            if "GOMP_teams4,(" not in line or "call" not in line:
+                continue
+            size = None
+            for j in range(k - 1, max(0, k - 40), -1):
+                m = re.search(r"st\.param\.u32 \[%out_arg3\],\s*(\S+);", lines[j])
+                if m:
+                    value = m.group(1)
+                    if re.fullmatch(r"-?\d+", value):
+                        size = int(value)
+                    else:
+                        for i in range(j - 1, max(0, j - 200), -1):
+                            w = re.search(r"mov\.u32 " + re.escape(value) + r",\s*(-?\d+);", lines[i])
+                            if w:
+                                size = int(w.group(1))
+                                break
+                    break
+            sizes.append(size)
+    return sizes
 
 
 def mapping_regions(binary):
@@ -117,16 +155,21 @@ def demangled(name):
 def main():
     args = sys.argv[1:]
     expect = "--expect-flagged" in args
-    binaries = [a for a in args if a != "--expect-flagged"]
+    sized_teams = "--sized-teams" in args
+    binaries = [a for a in args if a not in ("--expect-flagged", "--sized-teams")]
     if not binaries:
         sys.exit(__doc__)
-    flagged, scanned, maps, regions, tables = [], 0, [], 0, []
+    flagged, scanned, maps, regions, tables, sized, teams = [], 0, [], 0, [], [], 0
     for binary in binaries:
         for image in images(binary):
             for module in modules(image):
                 scanned += 1
                 for name, n in simt_stack_users(module):
                     flagged.append((os.path.basename(image), name, n))
+                for size in team_sizes(module):
+                    teams += 1
+                    if size != 0 and not sized_teams:
+                        sized.append((os.path.basename(image), size))
             for address, mapnum in mapping_regions(image):
                 regions += 1
                 if mapnum != 0:
@@ -144,12 +187,16 @@ def main():
         print(f"{image}: the target region launched at {address} {what}")
     for image, host, device in tables:
         print(f"{image}: {host} variables in the host's offload table, {device} in the device image's")
+    for image, size in sorted(set(sized)):
+        print(f"{image}: a teams region with thread_limit {size if size is not None else '(not a constant)'}")
     print(f"{scanned} PTX modules scanned, {len(unique)} bodies on the SIMT stack; "
-          f"{regions} target regions, {len(maps)} that map; {len(tables)} images whose variable tables differ")
+          f"{regions} target regions, {len(maps)} that map; {len(tables)} images whose variable tables differ; "
+          f"{teams} teams regions, {len(sized)} that name a team size"
+          + (" (allowed: --sized-teams)" if sized_teams else ""))
     if expect:
-        seen = bool(unique) and bool(maps)
-        print("the fixture is flagged by both checks: they see the patterns" if seen
-              else "FAILED: the fixture was not flagged by both checks (they no longer see the patterns)")
+        seen = bool(unique) and bool(maps) and bool(sized)
+        print("the fixture is flagged by all three checks: they see the patterns" if seen
+              else "FAILED: the fixture was not flagged by all three checks (they no longer see the patterns)")
         sys.exit(0 if seen else 1)
     if unique:
         print("FAILED: device bodies above keep locals on the lanes' private stack (see this script's header)")
@@ -157,7 +204,9 @@ def main():
         print("FAILED: target regions above map (see this script's header)")
     if tables:
         print("FAILED: the offload tables above differ: libgomp would refuse the image on a GPU")
-    sys.exit(1 if unique or maps or tables else 0)
+    if sized:
+        print("FAILED: teams regions above name a team size (see this script's header)")
+    sys.exit(1 if unique or maps or tables or sized else 0)
 
 
 if __name__ == "__main__":

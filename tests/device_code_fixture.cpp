@@ -1,10 +1,11 @@
-// The two patterns tests/check_device_code.py keeps out of the GPU code:
+// The three patterns tests/check_device_code.py keeps out of the GPU code:
 // a launch body that passes local arrays on to a function and reads them
 // back in a loop, which GCC 12 miscompiled for the GPU (as the Newton-step
-// operator had it), and a target region that maps a value, which costs a
-// launch 1.5 ms in GCC 12's libgomp. The program exists to be scanned
-// (`check_device_code.py --expect-flagged`): both must be flagged, or the
-// checks no longer see what they guard against. Run, it says whether its
+// operator had it), a target region that maps a value, which costs a
+// launch 1.5 ms in GCC 12's libgomp, and a teams region with a
+// thread_limit, which costs each team a malloc on the device. The program
+// exists to be scanned (`check_device_code.py --expect-flagged`): all three
+// must be flagged, or the checks no longer see what they guard against. Run, it says whether its
 // first result is right (on the host it is; on a GPU it was not).
 #include <cstdio>
 #include <vector>
@@ -44,6 +45,11 @@ int main() {
   double mapped = 0;  // a region that maps a value
 #pragma omp target map(tofrom : mapped)
   mapped = 1;
+  // and one that names its team size, which costs every team a malloc on
+  // the device (GOMP_teams4, kernels/launch.hpp)
+#pragma omp target teams thread_limit(4)
+  {
+  }
   const bool ok = r[7] == 3.0 && r[p + 7] == 3.0 && r[2 * p + 7] == 1.0 && mapped == 1;
   std::printf("fixture: rows of node 7 = (%g, %g, %g) (3, 3, 1 expected): %s\n", r[7], r[p + 7], r[2 * p + 7],
               ok ? "ok" : "WRONG");

@@ -84,7 +84,7 @@ TEST(ElasticityApply, OptimisedEqualsReferenceIncludingPlaneRanges) {
 // the compiler fuses multiply-adds differently in the two loops), on every
 // size, face set and block of rows, plain and fused; and on rows of 131 and
 // 151 nodes, whose runs of 128 nodes and more a lane sweeps 4 nodes at a
-// time (TRESCA_DEVICE_LANE_NODES, kernels/elasticity.cpp)
+// time (kernels/elasticity.cpp)
 TEST(ElasticityApply, RowFormEqualsTheBandedApply) {
   std::vector<std::array<index, 3>> sizes = {{130, 1, 2}, {150, 2, 1}};
   for (auto& s : kSizes) sizes.push_back({s[0], s[1], s[2]});
