@@ -207,8 +207,10 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
   //    the independent loads in flight, a U-th of the group loads. A run
   //    shorter than U warps (the one-node runs at a row's ends) is swept a
   //    node a lane; where U*S passes the run's end, a lane computes its
-  //    first node again and stores nothing for the others.
-  constexpr int P = 9, U = 4;
+  //    first node again and stores nothing for the others. Four in float
+  //    (1.48x one), one in double, whose values take twice the registers
+  //    (four: 12 % slower than one).
+  constexpr int P = 9, U = sizeof(T) == sizeof(float) ? 4 : 1;
   with_kind(out, [&](auto kind) {
     constexpr OutKind K = decltype(kind)::value;
     for_each_block(name, nz, nyr, nodes * in_precision<T>(apply_cost(out)), [=](index jz, index jy) {
@@ -252,7 +254,7 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
                        }
                      };
                      constexpr index kLanes = 32;  // a warp's (GCC's simd width on the GPU)
-                     if (i1 - i0 >= kLanes * U) return nodes_a_lane(std::integral_constant<int, U>{});
+                     if (U > 1 && i1 - i0 >= kLanes * U) return nodes_a_lane(std::integral_constant<int, U>{});
                      nodes_a_lane(std::integral_constant<int, 1>{});
                    });
     });

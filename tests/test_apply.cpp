@@ -82,9 +82,9 @@ TEST(ElasticityApply, OptimisedEqualsReferenceIncludingPlaneRanges) {
 // the row-parallel form (the device's, here on host threads): the banded
 // apply's answers to rounding (the same per-node sums in the same order;
 // the compiler fuses multiply-adds differently in the two loops), on every
-// size, face set and block of rows, plain and fused; and on rows of 131 and
-// 151 nodes, whose runs of 128 nodes and more a lane sweeps 4 nodes at a
-// time (kernels/elasticity.cpp)
+// size, face set and block of rows, plain and fused, in double and float;
+// and on rows of 131 and 151 nodes, whose runs of 128 nodes and more a lane
+// sweeps 4 nodes at a time in float (kernels/elasticity.cpp)
 TEST(ElasticityApply, RowFormEqualsTheBandedApply) {
   std::vector<std::array<index, 3>> sizes = {{130, 1, 2}, {150, 2, 1}};
   for (auto& s : kSizes) sizes.push_back({s[0], s[1], s[2]});
@@ -102,16 +102,22 @@ TEST(ElasticityApply, RowFormEqualsTheBandedApply) {
             elasticity_apply_rows(view(k), x.data(), bb ? residual_out(bb, yr.data()) : operator_out(yr.data()), rows);
             EXPECT_LE(max_abs_diff(y, yr), 1e-14 * max_abs(y)) << s[0] << "x" << s[1] << "x" << s[2] << " faces " << faces;
           }
+        // (float: the device's 4 nodes a lane, double's 1)
         const auto kf = stencil_in_precision<float>(k);
-        std::vector<float> xf(x.begin(), x.end()), yf(k.size()), yfr(k.size());
-        elasticity_apply(kf, xf.data(), yf.data(), RowBlock{0, g.nz(), 0, g.ny()});
-        elasticity_apply_rows(view(kf), xf.data(), operator_out(yfr.data()), RowBlock{0, g.nz(), 0, g.ny()});
-        float m = 0, d = 0;
-        for (size_t i = 0; i < yf.size(); ++i) {
-          m = std::max(m, std::abs(yf[i]));
-          d = std::max(d, std::abs(yf[i] - yfr[i]));
-        }
-        EXPECT_LE(d, 1e-5f * m) << "float";
+        const std::vector<float> xf(x.begin(), x.end()), bf(b.begin(), b.end());
+        for (const RowBlock& rows : blocks)
+          for (const float* bb : {(const float*)nullptr, bf.data()}) {
+            std::vector<float> yf(k.size(), 7.0f), yfr(k.size(), 7.0f);
+            elasticity_apply(kf, xf.data(), yf.data(), rows, bb);
+            elasticity_apply_rows(view(kf), xf.data(), bb ? residual_out(bb, yfr.data()) : operator_out(yfr.data()),
+                                  rows);
+            float m = 0, d = 0;
+            for (size_t i = 0; i < yf.size(); ++i) {
+              m = std::max(m, std::abs(yf[i]));
+              d = std::max(d, std::abs(yf[i] - yfr[i]));
+            }
+            EXPECT_LE(d, 1e-5f * m) << "float, " << s[0] << "x" << s[1] << "x" << s[2] << " faces " << faces;
+          }
       }
   });
 }
