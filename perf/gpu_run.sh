@@ -172,6 +172,7 @@ if [[ $stage == first ]]; then
   keep='^\[ +(PASSED|FAILED) +\]|_median|^== |largest difference|sets equal|iterations .* vs|same solution|DIFFERENT'
   keep+='|^(converged|not converged)|^work: .*peak|^times \[s\]|^# device|^apply y = Kx|^(apply \(float\)|dot|axpy|cg_update) +[0-9]|^V-cycle \('
   keep+='|exit status [1-9]|error|refused|^fixture:|^Device[A-Za-z]+/[0-9]+: '
+  keep+='|^(target |teams |\.\.\. ).* [0-9.]+ +[0-9.]+ +[0-9.]+$'  # (launch_probe's rows)
   keep+='| (device|copy) +[0-9]+ +[0-9.]+ +([5-9]|[1-9][0-9])\.[0-9]%|^in launches:'  # (kernels of 5 % and more)
   for f in "$out"/*.log; do
     echo "-- ${f##*/}"
