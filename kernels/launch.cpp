@@ -491,10 +491,10 @@ bool device_guarded() { return guard().on; }
 
 #ifdef TRESCA_OFFLOAD
 // Where the guard cannot close what a body reads (a std::vector's data is
-// not a Field), it reads the body: every 8-byte-aligned word is compared
-// with malloc's main heap, where small host arrays live. (A closure's
-// padding may hold stale stack or library addresses, so only the heap's
-// range is asked about.)
+// not a Field), it reads the body: each 8-byte word that holds an address
+// aligned as malloc returns them is compared with malloc's main heap,
+// where small host arrays live. (A closure's padding may hold stale stack
+// or library addresses, so only the heap's range is asked about.)
 void detail::check_device_body(const char* kernel, const void* body, std::size_t bytes) {
   const Guard& g = guard();
   if (!g.on) return;

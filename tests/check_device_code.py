@@ -54,8 +54,8 @@ Exit 0 when no body uses that stack, no region maps, the tables agree and no
 teams region names a size; 1 (naming what fails) otherwise. With
 --expect-flagged, the reverse: exit 0 only if BINARY has a body on the
 stack, a region that maps and a teams region that names its size
-(tests/device_code_fixture.cpp, written with both, shows that the checks
-still see them with this compiler)."""
+(tests/device_code_fixture.cpp, written with all three, shows that the
+checks still see them with this compiler)."""
 import os
 import re
 import subprocess

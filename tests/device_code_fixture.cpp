@@ -5,8 +5,9 @@
 // launch 1.5 ms in GCC 12's libgomp, and a teams region with a
 // thread_limit, which costs each team a malloc on the device. The program
 // exists to be scanned (`check_device_code.py --expect-flagged`): all three
-// must be flagged, or the checks no longer see what they guard against. Run, it says whether its
-// first result is right (on the host it is; on a GPU it was not).
+// must be flagged, or the checks no longer see what they guard against.
+// Run, it says whether its first result is right (on the host it is; on a
+// GPU it was not).
 #include <cstdio>
 #include <vector>
 

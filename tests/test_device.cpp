@@ -203,12 +203,22 @@ TEST(Field, LargeCopiesAndZeroingCoverEveryByte) {
   omp_set_num_threads(keep);
 }
 
+// why a DeviceGuard test cannot run here ("": it can): the guard is off, a
+// GPU guards its own memory, or (where it needs device launches) the build
+// has no offload
+static std::string why_no_guard(bool needs_launches) {
+  const char* e = std::getenv("TRESCA_DEVICE_GUARD");
+  if (!e || std::string(e) != "1") return "TRESCA_DEVICE_GUARD unset";
+  if (omp_get_num_devices() > 0) return "a GPU is present: its memory guards itself";
+  if (needs_launches && !offload_built()) return "built without TRESCA_OFFLOAD: no device launches";
+  return "";
+}
+
 // the guard that the device.guarded run relies on: a host read through a
 // device pointer stops the program
 TEST(DeviceGuard, StopsAHostReadOfDeviceMemory) {
-  const char* e = std::getenv("TRESCA_DEVICE_GUARD");
-  if (!e || std::string(e) != "1") GTEST_SKIP() << "TRESCA_DEVICE_GUARD unset";
-  if (omp_get_num_devices() > 0) GTEST_SKIP() << "a GPU is present: its memory guards itself";
+  const std::string why = why_no_guard(false);
+  if (!why.empty()) GTEST_SKIP() << why;
   ASSERT_TRUE(device_guarded());
   const Field<real> d = on_device({1, 2, 3});
   EXPECT_EQ(d.to_vector()[1], 2);  // through a copy: allowed
@@ -223,10 +233,8 @@ TEST(DeviceGuard, StopsAHostReadOfDeviceMemory) {
 // ... and a kernel that reads host memory (an illegal address on a GPU)
 // stops it too, while the same kernel over device memory runs
 TEST(DeviceGuard, StopsAKernelReadOfHostMemory) {
-  const char* e = std::getenv("TRESCA_DEVICE_GUARD");
-  if (!e || std::string(e) != "1") GTEST_SKIP() << "TRESCA_DEVICE_GUARD unset";
-  if (omp_get_num_devices() > 0) GTEST_SKIP() << "a GPU is present: its memory guards itself";
-  if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device launches";
+  const std::string why = why_no_guard(true);
+  if (!why.empty()) GTEST_SKIP() << why;
   const Field<real> host{1, 2, 3};
   OnDevice on;
   const Field<real> x = on_device({1, 2, 3});
@@ -242,10 +250,8 @@ TEST(DeviceGuard, StopsAKernelReadOfHostMemory) {
 // Coulomb fixed point's Anderson sums ran the device's dot over its host
 // vectors, RESULTS.md §0zm)
 TEST(DeviceGuard, StopsAKernelGivenAHostArray) {
-  const char* e = std::getenv("TRESCA_DEVICE_GUARD");
-  if (!e || std::string(e) != "1") GTEST_SKIP() << "TRESCA_DEVICE_GUARD unset";
-  if (omp_get_num_devices() > 0) GTEST_SKIP() << "a GPU is present: its memory guards itself";
-  if (!offload_built()) GTEST_SKIP() << "built without TRESCA_OFFLOAD: no device launches";
+  const std::string why = why_no_guard(true);
+  if (!why.empty()) GTEST_SKIP() << why;
   const std::vector<real> host{1, 2, 3};
   OnDevice on;
   const Field<real> x = on_device({1, 2, 3});
