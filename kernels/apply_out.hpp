@@ -7,16 +7,18 @@
 //
 //   the operator   y_j = v                                  operator_out(y)
 //   the residual   y_j = b_j - v                            residual_out(b, y)
-//   a Chebyshev    r_j = b_j - v (never stored),            chebyshev_out(b, dinv, d, s, t, y)
-//   step           d_j = s d_j + t dinv_j r_j,
-//                  y_j = x_j + d_j
+//   a Chebyshev    r_j = b_j - v (never stored),            chebyshev_out(b, dinv, s, t, y)
+//   step           y_j = x_j + s (x_j - y_j) + t dinv_j r_j
 //
 // The last is the multigrid smoother's step fused into the apply
-// (core/multigrid/smoothing.hpp): one sweep reads x, b, dinv and d and
-// writes d and the new iterate y (x != y), where the residual and a separate
-// update would write r and read it back, and read and write x once more:
-// 7 streams instead of 10 (RESULTS.md §0p). Where s == 0 (the first step)
-// d is not read, so it may hold anything.
+// (core/multigrid/smoothing.hpp) in the three-term form of the Chebyshev
+// recurrence: y holds the iterate before x and is overwritten by the one
+// after it, entry by entry. One sweep reads x, b, dinv and y and writes y,
+// where the residual and a separate update would write r and read it back,
+// and read and write x once more; and where the two-term form (d = s d +
+// t dinv r, y = x + d) read and wrote a vector d as well: 5 streams instead
+// of 7 (RESULTS.md §0zn) and of 10 (§0p). Where s == 0 (the first step) y
+// is not read, so it may hold anything.
 //
 // U is T or a vector of T (simd.hpp): put(), put_lanes() and add() load and
 // store U at p + j, so the CPU's explicit vectors and the device's scalar
@@ -32,8 +34,7 @@ template <class T>
 struct ApplyOut {
   T* y = nullptr;
   const T* b = nullptr;     // the residual's and the step's right-hand side
-  const T* dinv = nullptr;  // the step's; set with d, s and t
-  T* d = nullptr;
+  const T* dinv = nullptr;  // the step's; set with s and t
   T s = 0, t = 0;
 };
 
@@ -46,8 +47,8 @@ ApplyOut<T> residual_out(const T* b, T* y) {
   return {y, b};
 }
 template <class T>
-ApplyOut<T> chebyshev_out(const T* b, const T* dinv, T* d, T s, T t, T* y) {
-  return {y, b, dinv, d, s, t};
+ApplyOut<T> chebyshev_out(const T* b, const T* dinv, T s, T t, T* y) {
+  return {y, b, dinv, s, t};
 }
 
 // Everything that computes with an ApplyOut has internal linkage (an unnamed
@@ -86,7 +87,7 @@ inline void with_kind(const ApplyOut<T>& o, const F& f) {
   }
 }
 
-constexpr bool writes_d(OutKind k) { return k == OutKind::step_first || k == OutKind::step; }
+constexpr bool is_step(OutKind k) { return k == OutKind::step_first || k == OutKind::step; }
 
 // entry j's value v of an apply of x (K = kind(o); o by value: its
 // pointers stay in registers across the stores)
@@ -97,22 +98,21 @@ inline void put(const ApplyOut<T> o, const T* x, index j, U v) {
   } else if constexpr (K == OutKind::residual) {
     store_as<U>(o.y + j, load_as<U>(o.b + j) - v);
   } else {
-    U dn = o.t * load_as<U>(o.dinv + j) * (load_as<U>(o.b + j) - v);
-    if constexpr (K == OutKind::step) dn += o.s * load_as<U>(o.d + j);
-    store_as<U>(o.d + j, dn);
-    store_as<U>(o.y + j, load_as<U>(x + j) + dn);
+    const U xj = load_as<U>(x + j);
+    U yn = xj + o.t * load_as<U>(o.dinv + j) * (load_as<U>(o.b + j) - v);
+    if constexpr (K == OutKind::step) yn += o.s * (xj - load_as<U>(o.y + j));
+    store_as<U>(o.y + j, yn);
   }
 }
 
 // The same for a vector U whose lanes where `keep` is true were put before
 // (the banded apply's overlapping last vector of a run): those lanes of y
-// (and d) are stored back as they are, so each entry is put once.
+// are stored back as they are, so each entry is put once.
 template <OutKind K, class T, class U, class Mask>
 inline void put_lanes(const ApplyOut<T> o, const T* x, index j, U v, Mask keep) {
-  const U y_was = load_as<U>(o.y + j), d_was = writes_d(K) ? load_as<U>(o.d + j) : U{};
+  const U y_was = load_as<U>(o.y + j);
   put<K>(o, x, j, v);
   store_as<U>(o.y + j, keep ? y_was : load_as<U>(o.y + j));
-  if constexpr (writes_d(K)) store_as<U>(o.d + j, keep ? d_was : load_as<U>(o.d + j));
 }
 
 // entry j as if put() had been given v + w (the bottom block's term, added
@@ -124,16 +124,14 @@ inline void add(const ApplyOut<T> o, index j, U w) {
   } else if constexpr (K == OutKind::residual) {
     store_as<U>(o.y + j, load_as<U>(o.y + j) - w);
   } else {
-    const U c = o.t * load_as<U>(o.dinv + j) * w;
-    store_as<U>(o.d + j, load_as<U>(o.d + j) - c);
-    store_as<U>(o.y + j, load_as<U>(o.y + j) - c);
+    store_as<U>(o.y + j, load_as<U>(o.y + j) - o.t * load_as<U>(o.dinv + j) * w);
   }
 }
 
 }  // namespace
 
-// Cost per node of a Chebyshev step beyond the residual's: reads dinv and d,
-// writes d (3 dofs, double), 6 flops a dof
-constexpr Cost kChebStepExtraCost{72, 18};
+// Cost per node of a Chebyshev step beyond the residual's: reads dinv and
+// y's previous values (3 dofs, double), 6 flops a dof
+constexpr Cost kChebStepExtraCost{48, 18};
 
 }  // namespace tresca

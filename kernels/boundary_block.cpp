@@ -8,7 +8,7 @@ template <class T>
 void bottom_block_apply(const GridDims& g, const T* B, const T* x, const ApplyOut<T>& out) {
   const index M = g.nx() * g.ny(), N = g.nodes();
   const T *bxx = B, *bxy = B + M, *byy = B + 2 * M, *bzz = B + 3 * M;
-  const Cost step = writes_d(kind(out)) ? kChebStepExtraCost : Cost{};  // the Chebyshev step's dinv and d
+  const Cost step = is_step(kind(out)) ? kChebStepExtraCost : Cost{};  // the Chebyshev step's dinv and y
   const char* name = precision_name<T>("bottom block", "bottom block (float)");
   with_kind(out, [&](auto kind) {
     constexpr OutKind K = decltype(kind)::value;

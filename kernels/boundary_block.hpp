@@ -16,8 +16,8 @@ constexpr Cost kBottomBlockCost{104, 13};  // per bottom-face node
 
 // T = double or float (B, x and out's vectors all of T). As the last part of an apply whose stencil part is done (apply_out.hpp):
 // each bottom entry as if `out` had been given v + (B x)_j: y += B x for the
-// operator, y -= B x for the residual, and for the Chebyshev step d and the
-// new iterate less t dinv (B x).
+// operator, y -= B x for the residual, and for the Chebyshev step the new
+// iterate less t dinv (B x).
 template <class T>
 void bottom_block_apply(const GridDims& g, const T* B, const T* x, const ApplyOut<T>& out);
 // the _ref twin (double): y += alpha B x

@@ -91,15 +91,15 @@ ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& k);
 // Cost per output node (double fields; in_precision<float> halves the bytes):
 // y = K x reads x and writes y (3 components each; neighbour rows come from
 // cache), 153 FMAs; the residual b - K x also reads b.
-// The smoother's Chebyshev step (apply_out.hpp) writes the new iterate in
-// place of r and also reads dinv and d and writes d (kChebStepExtraCost).
+// The smoother's Chebyshev step (apply_out.hpp) writes the new iterate over
+// the one before x, which it also reads, and reads dinv (kChebStepExtraCost).
 constexpr Cost kApplyCost{48, 306};
 constexpr Cost kResidualCost{72, 309};
 constexpr Cost kChebStepCost = kResidualCost + kChebStepExtraCost;
 template <class T>
 constexpr Cost apply_cost(const ApplyOut<T>& out) {
   const OutKind k = kind(out);
-  return writes_d(k) ? kChebStepCost : k == OutKind::residual ? kResidualCost : kApplyCost;
+  return is_step(k) ? kChebStepCost : k == OutKind::residual ? kResidualCost : kApplyCost;
 }
 
 // y = K x for output planes iz in [z_begin, z_end) (the whole grid with

@@ -102,7 +102,7 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
   for (; i + kW <= i1; i += kW) {
     // The next block's lines that come from memory: the lead input row's
     // (every other input row was read by the rows before, and is in cache),
-    // and for the smoother's step those of b, dinv and d, which its epilogue
+    // and for the smoother's step those of b, dinv and y, which its epilogue
     // otherwise misses on in a burst after the block's arithmetic. The
     // hardware's prefetchers alone leave the apply a third slower on
     // meshes that do not fit the caches (RESULTS.md §0p, §0zj).
@@ -113,7 +113,7 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
         if constexpr (K == OutKind::step || K == OutKind::step_first) {
           __builtin_prefetch(o.b + row + j);
           __builtin_prefetch(o.dinv + row + j);
-          if constexpr (K == OutKind::step) __builtin_prefetch(o.d + row + j, 1);
+          if constexpr (K == OutKind::step) __builtin_prefetch(o.y + row + j, 1);
         }
       }
     stencil_block<K, T, kW>(g, f, xr, o, x, row, N, i);

@@ -204,24 +204,31 @@ void reciprocal_or_zero(index n, const real* x, To* y) {
 }
 
 template <class T>
-void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x) {
+void cheb_update(index n, T s, T t, const T* dinv, const T* r, const T* x, T* y) {
   const char* name = precision_name<T>("chebyshev update", "chebyshev update (float)");
   for_each_entry(name, n, in_precision<T>(kChebUpdateCost), [=](index i) {
-      d[i] = s * d[i] + t * dinv[i] * r[i];
-      x[i] += d[i];
+    const T yn = x[i] + t * dinv[i] * r[i];
+    y[i] = yn + s * (x[i] - y[i]);
   });
 }
 
 template <class T>
-void cheb_first(index n, T t, const T* dinv, const T* r, T* d, T* x, bool from_zero) {
+void cheb_first(index n, T t, const T* dinv, const T* b, T* x, T* p) {
   const char* name = precision_name<T>("chebyshev first", "chebyshev first (float)");
-  if (from_zero)
-    for_each_entry(name, n, in_precision<T>(kChebFirstCost), [=](index i) { x[i] = d[i] = t * dinv[i] * r[i]; });
-  else
-    for_each_entry(name, n, in_precision<T>(kChebFirstOnGuessCost), [=](index i) {
-      d[i] = t * dinv[i] * r[i];
-      x[i] += d[i];
-    });
+  for_each_entry(name, n, in_precision<T>(kChebFirstCost), [=](index i) {
+    x[i] = t * dinv[i] * b[i];
+    p[i] = 0;
+  });
+}
+
+template <class T>
+void cheb_first_on_guess(index n, T t, const T* dinv, T* r, T* x) {
+  const char* name = precision_name<T>("chebyshev first on a guess", "chebyshev first on a guess (float)");
+  for_each_entry(name, n, in_precision<T>(kChebFirstOnGuessCost), [=](index i) {
+    const T x0 = x[i];
+    x[i] = x0 + t * dinv[i] * r[i];
+    r[i] = x0;
+  });
 }
 
 template real dot<double>(index, const double*, const double*);
@@ -244,10 +251,12 @@ template void scatter_to<double, double>(index, const index*, const double*, dou
 template void scatter_to<float, double>(index, const index*, const double*, float*);
 template void gather_from<double, double>(index, const index*, const double*, double*);
 template void gather_from<double, float>(index, const index*, const float*, double*);
-template void cheb_update<double>(index, double, double, const double*, const double*, double*, double*);
-template void cheb_update<float>(index, float, float, const float*, const float*, float*, float*);
-template void cheb_first<double>(index, double, const double*, const double*, double*, double*, bool);
-template void cheb_first<float>(index, float, const float*, const float*, float*, float*, bool);
+template void cheb_update<double>(index, double, double, const double*, const double*, const double*, double*);
+template void cheb_update<float>(index, float, float, const float*, const float*, const float*, float*);
+template void cheb_first<double>(index, double, const double*, const double*, double*, double*);
+template void cheb_first<float>(index, float, const float*, const float*, float*, float*);
+template void cheb_first_on_guess<double>(index, double, const double*, double*, double*);
+template void cheb_first_on_guess<float>(index, float, const float*, float*, float*);
 
 
 }  // namespace tresca

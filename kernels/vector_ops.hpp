@@ -7,8 +7,9 @@
 // Cost models (bytes moved, flops), n entries of 8 bytes:
 //   dot 16n B, 2n F;  axpy 24n B, 2n F;  xpay 24n B, 2n F;  triad 24n B, 2n F;
 //   cg_update (x += a p, r -= a q, returns r.r) 48n B, 6n F;
-//   cheb_update (d = s d + t Dinv r, x += d) 40n B, 5n F;
-//   cheb_first (d = t Dinv b, x = d) 32n B, 2n F; (..., x += d) 40n B, 3n F;
+//   cheb_update (y = x + t Dinv r + s (x - y)) 40n B, 6n F;
+//   cheb_first (x = t Dinv b, p = 0) 32n B, 2n F;
+//   cheb_first_on_guess ((x, r) = (x + t Dinv r, x)) 40n B, 3n F;
 //   jacobi_cg_update (r -= a q, returns r.(Dinv r)) 32n B, 5n F;
 //   jacobi_xpay (p = Dinv r + b p) 32n B, 3n F.
 // (Fields of float move half the bytes: in_precision<float>, types.hpp.
@@ -20,7 +21,7 @@ namespace tresca {
 
 constexpr index kDotBlock = 4096;
 // per entry (the table above)
-constexpr Cost kDotCost{16, 2}, kAxpyCost{24, 2}, kXpayCost{24, 2}, kCgUpdateCost{48, 6}, kChebUpdateCost{40, 5},
+constexpr Cost kDotCost{16, 2}, kAxpyCost{24, 2}, kXpayCost{24, 2}, kCgUpdateCost{48, 6}, kChebUpdateCost{40, 6},
     kChebFirstCost{32, 2}, kChebFirstOnGuessCost{40, 3}, kCopyCost{16, 0}, kFillCost{8, 0}, kScaleCost{16, 1},
     kHadamardCost{24, 1}, kTriadCost{24, 2}, kJacobiCgUpdateCost{32, 5}, kJacobiXpayCost{32, 3};
 
@@ -72,15 +73,21 @@ template <class T>
 real jacobi_cg_update_ref(index n, T a, const T* q, const T* dinv, T* r);
 template <class T>
 void jacobi_xpay(index n, const T* dinv, const T* r, T b, T* p);
-// d = s d + t dinv .* r; x += d   (T = double, float): a smoother step's
+// The Chebyshev smoother's steps outside the apply (core/multigrid/smoothing.hpp:
+// x_{k+1} = x_k + s (x_k - x_{k-1}) + t Dinv r_k), T = double, float.
+//
+// y = x + t dinv .* r + s (x - y), y holding x_{k-1} on entry: a step's
 // update unfused from its residual (the V-cycle runs the fused step of the
-// apply, apply_out.hpp; this is bench_kernels' ChebStepUnfused reference)
+// apply, apply_out.hpp, with the same arithmetic in the same order; this is
+// bench_kernels' ChebStepUnfused reference)
 template <class T>
-void cheb_update(index n, T s, T t, const T* dinv, const T* r, T* d, T* x);
-// first Chebyshev step, d = t dinv .* r, from x = 0 (x = d; r = b) or from a
-// guess x (x += d; r = b - A x): cheb_update with s = 0, bit for bit, without
-// reading (or first zeroing) the old d
+void cheb_update(index n, T s, T t, const T* dinv, const T* r, const T* x, T* y);
+// the first step from x_0 = 0: x = t dinv .* b, and p = x_0 = 0 for the next
 template <class T>
-void cheb_first(index n, T t, const T* dinv, const T* r, T* d, T* x, bool from_zero = true);
+void cheb_first(index n, T t, const T* dinv, const T* b, T* x, T* p);
+// the first step from a guess x with r = b - A x: x += t dinv .* r (as
+// cheb_update with s = 0, bit for bit), and r = the guess, x_0 for the next
+template <class T>
+void cheb_first_on_guess(index n, T t, const T* dinv, T* r, T* x);
 
 }  // namespace tresca

@@ -287,27 +287,26 @@ TEST(VectorOps, ProfileRowsSayWhatRanThreaded) {
 
 TEST(VectorOps, ChebyshevUpdatesFollowTheirFormulas) {
   const index n = 1001;
-  const auto dinv = test::random_vector(n, 7), r = test::random_vector(n, 8);
-  auto d = test::random_vector(n, 9), x = test::random_vector(n, 10);
-  const auto d0 = d, x0 = x;
-  cheb_update(n, 0.3, 0.7, dinv.data(), r.data(), d.data(), x.data());
+  const auto dinv = test::random_vector(n, 7), r = test::random_vector(n, 8), x = test::random_vector(n, 10);
+  const auto prev = test::random_vector(n, 9);
+  auto y = prev;
+  cheb_update(n, 0.3, 0.7, dinv.data(), r.data(), x.data(), y.data());
+  for (index i = 0; i < n; ++i) ASSERT_NEAR(y[i], x[i] + 0.3 * (x[i] - prev[i]) + 0.7 * dinv[i] * r[i], 1e-14);
+  // from zero: x_1 = t dinv b, x_0 = 0 left for the next step, whatever it held
+  std::vector<real> x1(n, std::nan("")), p(n, std::nan(""));
+  cheb_first(n, 0.5, dinv.data(), r.data(), x1.data(), p.data());
   for (index i = 0; i < n; ++i) {
-    const real di = 0.3 * d0[i] + 0.7 * dinv[i] * r[i];
-    ASSERT_NEAR(d[i], di, 1e-15);
-    ASSERT_NEAR(x[i], x0[i] + di, 1e-15);
+    ASSERT_NEAR(x1[i], 0.5 * dinv[i] * r[i], 1e-15);
+    ASSERT_EQ(p[i], 0.0);
   }
-  cheb_first(n, 0.5, dinv.data(), r.data(), d.data(), x.data());
+  // from a guess: cheb_update with s = 0, bit for bit, and the guess left where r was
+  auto r1 = r, x2 = x;
+  std::vector<real> y2 = prev;
+  cheb_first_on_guess(n, 0.7, dinv.data(), r1.data(), x2.data());
+  cheb_update(n, 0.0, 0.7, dinv.data(), r.data(), x.data(), y2.data());
   for (index i = 0; i < n; ++i) {
-    ASSERT_NEAR(d[i], 0.5 * dinv[i] * r[i], 1e-15);
-    ASSERT_EQ(x[i], d[i]);
-  }
-  // from a guess: cheb_update with s = 0 on a zeroed d, bit for bit, whatever d held
-  std::vector<real> d1(n, std::nan("")), x1 = x0, d2(n, 0.0), x2 = x0;
-  cheb_first(n, 0.7, dinv.data(), r.data(), d1.data(), x1.data(), false);
-  cheb_update(n, 0.0, 0.7, dinv.data(), r.data(), d2.data(), x2.data());
-  for (index i = 0; i < n; ++i) {
-    ASSERT_EQ(d1[i], d2[i]);
-    ASSERT_EQ(x1[i], x2[i]);
+    ASSERT_EQ(x2[i], y2[i]);
+    ASSERT_EQ(r1[i], x[i]);
   }
 }
 

@@ -48,11 +48,11 @@ class ElasticityOperator : public LinearOperator {
   }
   // a step of the multigrid smoother's Chebyshev iteration fused into the
   // apply (kernels/apply_out.hpp): with r = b - (K + B) x never stored,
-  // d = s d + t dinv r (d not read where s == 0) and y = x + d; x's ghost
-  // rows as they are, y's zeroed, d's untouched
+  // y = x + s (x - y) + t dinv r, y holding the iterate before x (not read
+  // where s == 0); x's ghost rows as they are, y's zeroed
   template <class T>
-  void chebyshev_step(const T* b, const T* x, T* y, const T* dinv, T* d, T s, T t) const {
-    apply_rows<T>(x, chebyshev_out(b, dinv, d, s, t, y), 0, slab_.local.nz());
+  void chebyshev_step(const T* b, const T* x, T* y, const T* dinv, T s, T t) const {
+    apply_rows<T>(x, chebyshev_out(b, dinv, s, t, y), 0, slab_.local.nz());
   }
   void update_ghosts(real* x) const override { halo_.exchange(x); }
   void update_ghosts(float* x) const { halo_.exchange(x); }

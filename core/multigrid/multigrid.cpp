@@ -266,7 +266,6 @@ void Multigrid::build_work(const Multigrid* like) {
       }
       const HostLaunches where(on_host(l));
       w.r.resize(n);
-      w.d.resize(n);
       if (crosses) {
         w.host_x.resize(n);
         w.host_b.resize(n);
@@ -387,11 +386,11 @@ void Multigrid::smooth(int l, bool zero_guess, const T* in) const {
   ScopedTimer t(Kernel::smoother);
   const ElasticityOperator& A = levels_[l].A;
   chebyshev_smooth<T>(
-      A.size(), levels_[l].lmax, opt_.range, opt_.degree, zero_guess, dinv_l, w.bp, w.xp, w.r.data(), w.d.data(),
+      A.size(), levels_[l].lmax, opt_.range, opt_.degree, zero_guess, dinv_l, w.bp, w.xp, w.r.data(),
       [&](T* x, T* r) { residual<T>(l, w.bp, x, r); },
       [&](T* x, T* y, T s, T t) {
         A.update_ghosts(x);
-        A.chebyshev_step(w.bp, x, y, dinv_l, w.d.data(), s, t);
+        A.chebyshev_step(w.bp, x, y, dinv_l, s, t);
       },
       in);
 }

@@ -234,7 +234,7 @@ class Multigrid : public LinearOperator {
   // share (their V-cycles never overlap: apply checks it)
   template <class T>
   struct Work {
-    Field<T> x, b, r, d, fine_rows, coarse_rows;
+    Field<T> x, b, r, fine_rows, coarse_rows;
     T* xp = nullptr;        // iterate and right-hand side in use: the
     const T* bp = nullptr;  // caller's arrays on a double level 0, host_x and host_b on
                             // the first host level of a device run (x and b: their device

@@ -1,16 +1,18 @@
 // The pieces of the multigrid V-cycle (multigrid.hpp) that see only vectors:
 //
 // * chebyshev_smooth: `degree` steps of the Chebyshev polynomial in D^{-1}A
-//   targeting [lmax/range, lmax]: x_{k+1} = x_k + d_{k+1} with
-//   d_{k+1} = s_k d_k + t_k Dinv (b - A x_k). `step(x, y, s, t)` is one step
-//   from x into y != x with the residual never stored (the operator's
-//   chebyshev_step: kernels/apply_out.hpp; s = 0 for the first); the steps
-//   go back and forth between x and r, and the iterate leaves in x. It
-//   enters as 0 (zero_guess; the first step needs no residual, x = d =
-//   t Dinv b, and goes to whichever vector makes the rest end in x) or in
-//   `in` (x or r): in chebyshev_entry(degree, x, r) every step is a fused
-//   one; in the other vector the first step forms a residual and updates the
-//   iterate in place (`residual(x, y)`, y = b - A x, into the free vector).
+//   targeting [lmax/range, lmax], in the three-term form x_{k+1} = x_k +
+//   s_k (x_k - x_{k-1}) + t_k Dinv (b - A x_k). `step(x, y, s, t)` is one
+//   step from x into y != x, y holding x_{k-1}, with the residual never
+//   stored (the operator's chebyshev_step: kernels/apply_out.hpp; s = 0
+//   for the first); the steps go back and forth between x and r, and the
+//   iterate leaves in x. It enters as 0 (zero_guess; the first step needs no
+//   residual, x = t Dinv b, and goes to whichever vector makes the rest end
+//   in x, the other set to x_0 = 0) or in `in` (x or r): in
+//   chebyshev_entry(degree, x, r) every step is a fused one; in the other
+//   vector the first step forms a residual in the free vector (`residual(x,
+//   y)`, y = b - A x), updates the iterate in place and leaves x_0 where
+//   the residual was (cheb_first_on_guess).
 // * lanczos_lmax: the largest eigenvalue of D^{-1}A from 15 steps of
 //   Jacobi-PCG (Lanczos) in double or float, times 1.15, at least 2.3;
 //   dots through `reduce` (the sum over the ranks of a split level; null:
@@ -36,11 +38,11 @@ T* chebyshev_entry(int degree, T* x, T* r) {
 
 template <class T, class Residual, class Step>
 void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_guess, const T* dinv, const T* b, T* x, T* r,
-                      T* d, Residual&& residual, Step&& step, const T* in = nullptr) {
+                      Residual&& residual, Step&& step, const T* in = nullptr) {
   TRESCA_ASSERT(degree >= 1);
   const real lmin = lmax / range;
   const real theta = (lmax + lmin) / 2, delta = (lmax - lmin) / 2, sigma = theta / delta;
-  // step k's coefficients: d = s d + t Dinv r (s = 0 for the first, k = 0)
+  // step k's coefficients: x_{k+1} = x_k + s (x_k - x_{k-1}) + t Dinv r (s = 0 for the first, k = 0)
   real rho = 1 / sigma, s = 0, t = 1 / theta;
   auto next = [&] {
     const real rho_new = 1 / (2 * sigma - rho);
@@ -53,12 +55,12 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
   T* at = zero_guess ? chebyshev_entry(degree - 1, x, r) : in == r ? r : x;
   int k = 0;
   if (zero_guess) {  // from x = 0: no residual to form
-    cheb_first<T>(n, T(t), dinv, b, d, at);
+    cheb_first<T>(n, T(t), dinv, b, at, other(at));
     next();
     k = 1;
   } else if (at != chebyshev_entry(degree, x, r)) {  // the first step in place
     residual(at, other(at));
-    cheb_first<T>(n, T(t), dinv, other(at), d, at, false);
+    cheb_first_on_guess<T>(n, T(t), dinv, other(at), at);
     next();
     k = 1;
   }
