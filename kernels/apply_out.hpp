@@ -13,12 +13,18 @@
 // The last is the multigrid smoother's step fused into the apply
 // (core/multigrid/smoothing.hpp) in the three-term form of the Chebyshev
 // recurrence: y holds the iterate before x and is overwritten by the one
-// after it, entry by entry. One sweep reads x, b, dinv and y and writes y,
-// where the residual and a separate update would write r and read it back,
-// and read and write x once more; and where the two-term form (d = s d +
-// t dinv r, y = x + d) read and wrote a vector d as well: 5 streams instead
-// of 7 (RESULTS.md §0zn) and of 10 (§0p). Where s == 0 (the first step) y
-// is not read, so it may hold anything.
+// after it, entry by entry. Its Jacobi weights dinv = 1 / diag(K + B) are
+// read from the array only on the bottom plane (iz = 0, where a bottom block
+// may add to the diagonal); elsewhere they are the stencil's own inv_center
+// of the node's class (elasticity.hpp), and 1 on constrained nodes (their
+// rows are the identity's), which the array must equal there (the
+// multigrid's is made from the same stencil).
+// So one sweep streams x, b and y and writes y, where the residual and a
+// separate update would write r and read it back, and read and write x
+// once more; and where the two-term form (d = s d + t dinv r, y = x + d)
+// with dinv as an array streamed dinv and d as well: 4 streams instead of
+// 7 (RESULTS.md §0zn) and of 10 (§0p). Where s == 0 (the first step) y is
+// not read, so it may hold anything.
 //
 // U is T or a vector of T (simd.hpp): put(), put_lanes() and add() load and
 // store U at p + j, so the CPU's explicit vectors and the device's scalar
@@ -34,7 +40,7 @@ template <class T>
 struct ApplyOut {
   T* y = nullptr;
   const T* b = nullptr;     // the residual's and the step's right-hand side
-  const T* dinv = nullptr;  // the step's; set with s and t
+  const T* dinv = nullptr;  // the step's (read where the header says); set with s and t
   T s = 0, t = 0;
 };
 
@@ -89,17 +95,29 @@ inline void with_kind(const ApplyOut<T>& o, const F& f) {
 
 constexpr bool is_step(OutKind k) { return k == OutKind::step_first || k == OutKind::step; }
 
+// The step's dinv_j for entry j of component a of a run of free nodes: the
+// run's class's weights (dc: the stencil's inv_center of that class, its 3
+// components) or, where dc is null (the bottom plane), o.dinv's. Nothing
+// for the other kinds.
+template <OutKind K, class U, class T>
+inline U dinv_at(const ApplyOut<T>& o, const T* dc, int a, index j) {
+  if constexpr (!is_step(K))
+    return U{};
+  else
+    return dc ? U{} + dc[a] : load_as<U>(o.dinv + j);
+}
+
 // entry j's value v of an apply of x (K = kind(o); o by value: its
-// pointers stay in registers across the stores)
+// pointers stay in registers across the stores); dj: dinv_at's for j
 template <OutKind K, class T, class U>
-inline void put(const ApplyOut<T> o, const T* x, index j, U v) {
+inline void put(const ApplyOut<T> o, const T* x, index j, U v, U dj) {
   if constexpr (K == OutKind::value) {
     store_as<U>(o.y + j, v);
   } else if constexpr (K == OutKind::residual) {
     store_as<U>(o.y + j, load_as<U>(o.b + j) - v);
   } else {
     const U xj = load_as<U>(x + j);
-    U yn = xj + o.t * load_as<U>(o.dinv + j) * (load_as<U>(o.b + j) - v);
+    U yn = xj + o.t * dj * (load_as<U>(o.b + j) - v);
     if constexpr (K == OutKind::step) yn += o.s * (xj - load_as<U>(o.y + j));
     store_as<U>(o.y + j, yn);
   }
@@ -109,14 +127,14 @@ inline void put(const ApplyOut<T> o, const T* x, index j, U v) {
 // (the banded apply's overlapping last vector of a run): those lanes of y
 // are stored back as they are, so each entry is put once.
 template <OutKind K, class T, class U, class Mask>
-inline void put_lanes(const ApplyOut<T> o, const T* x, index j, U v, Mask keep) {
+inline void put_lanes(const ApplyOut<T> o, const T* x, index j, U v, U dj, Mask keep) {
   const U y_was = load_as<U>(o.y + j);
-  put<K>(o, x, j, v);
+  put<K>(o, x, j, v, dj);
   store_as<U>(o.y + j, keep ? y_was : load_as<U>(o.y + j));
 }
 
 // entry j as if put() had been given v + w (the bottom block's term, added
-// after the stencil's)
+// after the stencil's: on the bottom plane, so dinv from the array)
 template <OutKind K, class T, class U>
 inline void add(const ApplyOut<T> o, index j, U w) {
   if constexpr (K == OutKind::value) {
@@ -130,8 +148,8 @@ inline void add(const ApplyOut<T> o, index j, U w) {
 
 }  // namespace
 
-// Cost per node of a Chebyshev step beyond the residual's: reads dinv and
-// y's previous values (3 dofs, double), 6 flops a dof
-constexpr Cost kChebStepExtraCost{48, 18};
+// Cost per node of a Chebyshev step beyond the residual's: reads y's
+// previous values (3 dofs, double; dinv is the class's, in cache), 6 flops a dof
+constexpr Cost kChebStepExtraCost{24, 18};
 
 }  // namespace tresca

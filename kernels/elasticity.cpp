@@ -109,7 +109,10 @@ ElasticityStencil build_elasticity_stencil(const GridDims& g, unsigned faces, re
           for (const StencilGroup& q : by_mask[m]) k.groups.push_back(q);
           k.first.push_back(std::int32_t(k.groups.size()));
         }
-        for (int a = 0; a < 3; ++a) k.center.push_back(S[13][a][a]);
+        for (int a = 0; a < 3; ++a) {
+          k.center.push_back(S[13][a][a]);
+          k.inv_center.push_back(1 / S[13][a][a]);
+        }
       }
   k.move_to(host.space_before());
   return k;
@@ -131,7 +134,10 @@ ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& kk) {
   t.slot = k.slot;
   t.first = k.first;
   for (const StencilGroup& q : k.groups) t.groups.push_back({q.off, {T(q.c[0]), T(q.c[1]), T(q.c[2])}});
-  for (real c : k.center) t.center.push_back(T(c));
+  for (real c : k.center) {
+    t.center.push_back(T(c));
+    t.inv_center.push_back(T(1 / c));  // (as the multigrid's dinv: 1 / diag in double, rounded to T)
+  }
   t.move_to(host.space_before());
   return t;
 }
@@ -142,7 +148,7 @@ template <class T>
 StencilView<T> view(const ElasticityStencilT<T>& k) {
   return StencilView<T>{k.g,          {k.cls[0].data(), k.cls[1].data(), k.cls[2].data()},
                         k.run_begin.data(), index(k.run_begin.size()) - 1,
-                        k.slot.data(), k.first.data(), k.groups.data()};
+                        k.slot.data(), k.first.data(), k.groups.data(), k.inv_center.data()};
 }
 template StencilView<double> view(const ElasticityStencilT<double>&);
 template StencilView<float> view(const ElasticityStencilT<float>&);
@@ -215,7 +221,7 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
     constexpr OutKind K = decltype(kind)::value;
     for_each_block(name, nz, nyr, nodes * in_precision<T>(apply_cost(out)), [=](index jz, index jy) {
       sweep_row<K>(k, nx, ny, N, z0 + jz, y0 + jy, x, out,
-                   [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
+                   [&](const std::int32_t* f, const T* xr, index row, index i0, index i1, const T* dc) {
                      const StencilGroupT<T>*q0 = k.groups + f[0], *q1 = k.groups + f[7];
                      auto nodes_a_lane = [&](auto width) {
                        constexpr int W = decltype(width)::value;
@@ -247,9 +253,10 @@ void elasticity_apply_rows(const StencilView<T>& k, const T* x, const ApplyOut<T
 #pragma GCC unroll 4
                          for (int u = 0; u < W; ++u)
                            if (u == 0 || i0 + j + u * S < i1) {
-                             put<K>(out, x, row + at[u], acc[u][0]);
-                             put<K>(out, x, N + row + at[u], acc[u][1]);
-                             put<K>(out, x, 2 * N + row + at[u], acc[u][2]);
+                             for (int a = 0; a < 3; ++a) {
+                               const index jj = a * N + row + at[u];
+                               put<K>(out, x, jj, acc[u][a], dinv_at<K, T>(out, dc, a, jj));
+                             }
                            }
                        }
                      };

@@ -61,7 +61,8 @@ struct ElasticityStencilT {
   Field<std::int32_t> slot;
   Field<std::int32_t> first;
   Field<StencilGroupT<T>> groups;
-  Field<T> center;  // diagonal coefficient per stencil and component: center[3*s+a]
+  Field<T> center;      // diagonal coefficient per stencil and component: center[3*s+a]
+  Field<T> inv_center;  // its reciprocal (the smoother's Jacobi weights off the bottom plane: apply_out.hpp)
 
   index nodes() const { return g.nodes(); }
   index size() const { return 3 * g.nodes(); }
@@ -73,6 +74,7 @@ struct ElasticityStencilT {
     first.move_to(s);
     groups.move_to(s);
     center.move_to(s);
+    inv_center.move_to(s);
   }
 };
 using ElasticityStencil = ElasticityStencilT<real>;
@@ -92,7 +94,8 @@ ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& k);
 // y = K x reads x and writes y (3 components each; neighbour rows come from
 // cache), 153 FMAs; the residual b - K x also reads b.
 // The smoother's Chebyshev step (apply_out.hpp) writes the new iterate over
-// the one before x, which it also reads, and reads dinv (kChebStepExtraCost).
+// the one before x, which it also reads (kChebStepExtraCost; its Jacobi
+// weights come from the stencil's inv_center, in cache).
 constexpr Cost kApplyCost{48, 306};
 constexpr Cost kResidualCost{72, 309};
 constexpr Cost kChebStepCost = kResidualCost + kChebStepExtraCost;
@@ -159,6 +162,7 @@ struct StencilView {
   const std::int32_t* slot;
   const std::int32_t* first;
   const StencilGroupT<T>* groups;
+  const T* inv_center;
 };
 template <class T>
 StencilView<T> view(const ElasticityStencilT<T>& k);

@@ -48,20 +48,35 @@ inline void accumulate(const StencilGroupT<T>* g, const StencilGroupT<T>* ge, co
 // xr = x + row. The first `done` entries are computed but not put (they
 // were: a Chebyshev step's put may not run twice on an entry). Always
 // inlined: GCC otherwise calls the smoother step's copy once a block, and
-// the fused step at level 12 runs 5-12 % slower (RESULTS.md §0zj).
-template <OutKind K, class T, int W>
+// the fused step at level 12 runs 5-12 % slower (RESULTS.md §0zj). A step's
+// weights come from the array (kArray: the bottom plane) or are the class's
+// dc (apply_out.hpp: dinv_at, here with its source known when compiled: a
+// test per entry cost the step a tenth on one core, RESULTS.md §0zn).
+template <OutKind K, class T, int W, bool kArray>
 __attribute__((always_inline)) inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f,
-                                                         const T* xr, const ApplyOut<T> o, const T* x, index row,
-                                                         index N, index i, int done = 0) {
+                                                         const T* dc, const T* xr, const ApplyOut<T> o, const T* x,
+                                                         index row, index N, index i, int done = 0) {
   using V = Vec<T>;
   constexpr int kLanes = Simd<T>::lanes;
+  auto weight = [&](auto u, int a, index j) {
+    using U = decltype(u);
+    if constexpr (!is_step(K))
+      return U{};
+    else if constexpr (kArray)
+      return load_as<U>(o.dinv + j);
+    else
+      return U{} + dc[a];  // (a broadcast load: weights held in registers across the block spilled its sums)
+  };
   if constexpr (W % kLanes != 0) {
     // scalar path for runs shorter than one vector
     for (int l = 0; l < W; ++l) {
       T acc[3] = {0, 0, 0};
       for (const StencilGroupT<T>* q = g + f[0]; q != g + f[7]; ++q)
         for (int a = 0; a < 3; ++a) acc[a] += q->c[a] * xr[i + l + q->off];
-      for (int a = 0; a < 3; ++a) put<K>(o, x, a * N + row + i + l, acc[a]);
+      for (int a = 0; a < 3; ++a) {
+        const index j = a * N + row + i + l;
+        put<K>(o, x, j, acc[a], weight(T{}, a, j));
+      }
     }
   } else {
     constexpr int NV = W / kLanes;
@@ -80,19 +95,25 @@ __attribute__((always_inline)) inline void stencil_block(const StencilGroupT<T>*
       V lane;
       for (int l = 0; l < kLanes; ++l) lane[l] = T(l);
       const auto keep = lane < T(done);
-      for (int a = 0; a < 3; ++a) put_lanes<K>(o, x, a * N + row + i, out[a][0], keep);
+      for (int a = 0; a < 3; ++a) {
+        const index j = a * N + row + i;
+        put_lanes<K>(o, x, j, out[a][0], weight(V{}, a, j), keep);
+      }
       return;
     }
     for (int a = 0; a < 3; ++a)
-      for (int l = 0; l < NV; ++l) put<K>(o, x, a * N + row + i + kLanes * l, out[a][l]);
+      for (int l = 0; l < NV; ++l) {
+        const index j = a * N + row + i + kLanes * l;
+        put<K>(o, x, j, out[a][l], weight(V{}, a, j));
+      }
   }
 }
 
 // `lead`: the offset from a node to its input that no row before it in the
 // band's order read (one plane and one row on: apply_band)
-template <OutKind K, class T>
-inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* xr, const ApplyOut<T> o,
-                          const T* x, index row, index N, index i0, index i1, index lead) {
+template <OutKind K, class T, bool kArray>
+inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* dc, const T* xr,
+                          const ApplyOut<T> o, const T* x, index row, index N, index i0, index i1, index lead) {
   constexpr int kLanes = Simd<T>::lanes;
   // three vectors per block: 9 accumulators + 3 inputs fit the 16 registers of
   // SSE/AVX2 (and AVX-512's 32); the width is measured (perf/RESULTS.md §0i)
@@ -102,7 +123,7 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
   for (; i + kW <= i1; i += kW) {
     // The next block's lines that come from memory: the lead input row's
     // (every other input row was read by the rows before, and is in cache),
-    // and for the smoother's step those of b, dinv and y, which its epilogue
+    // and for the smoother's step those of b and y, which its epilogue
     // otherwise misses on in a burst after the block's arithmetic. The
     // hardware's prefetchers alone leave the apply a third slower on
     // meshes that do not fit the caches (RESULTS.md §0p, §0zj).
@@ -110,21 +131,21 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
       for (int l = 0; l < kW; l += kLine) {
         const index j = a * N + i + kW + l;
         __builtin_prefetch(xr + lead + j);
-        if constexpr (K == OutKind::step || K == OutKind::step_first) {
+        if constexpr (is_step(K)) {
           __builtin_prefetch(o.b + row + j);
-          __builtin_prefetch(o.dinv + row + j);
+          if constexpr (kArray) __builtin_prefetch(o.dinv + row + j);
           if constexpr (K == OutKind::step) __builtin_prefetch(o.y + row + j, 1);
         }
       }
-    stencil_block<K, T, kW>(g, f, xr, o, x, row, N, i);
+    stencil_block<K, T, kW, kArray>(g, f, dc, xr, o, x, row, N, i);
   }
-  for (; i + kLanes <= i1; i += kLanes) stencil_block<K, T, kLanes>(g, f, xr, o, x, row, N, i);
+  for (; i + kLanes <= i1; i += kLanes) stencil_block<K, T, kLanes, kArray>(g, f, dc, xr, o, x, row, N, i);
   if (i < i1 && i1 - i0 >= kLanes) {
     // finish with one overlapping vector: computes a few entries again, puts the new ones
-    stencil_block<K, T, kLanes>(g, f, xr, o, x, row, N, i1 - kLanes, int(i - (i1 - kLanes)));
+    stencil_block<K, T, kLanes, kArray>(g, f, dc, xr, o, x, row, N, i1 - kLanes, int(i - (i1 - kLanes)));
     return;
   }
-  for (; i < i1; ++i) stencil_block<K, T, 1>(g, f, xr, o, x, row, N, i);
+  for (; i < i1; ++i) stencil_block<K, T, 1, kArray>(g, f, dc, xr, o, x, row, N, i);
 }
 
 }  // namespace
@@ -139,9 +160,15 @@ void apply_band(const StencilView<T>& v, const T* x, const ApplyOut<T>& o, const
     constexpr OutKind K = decltype(kind)::value;
     for (index iz = rows.z_begin; iz < rows.z_end; ++iz)
       for (index iy = rows.y_begin; iy < rows.y_end; ++iy)
-        sweep_row<K>(v, nx, ny, N, iz, iy, x, o, [&](const std::int32_t* f, const T* xr, index row, index i0, index i1) {
-          stencil_range<K, T>(v.groups, f, xr, o, x, row, N, i0, i1, lead);
-        });
+        sweep_row<K>(v, nx, ny, N, iz, iy, x, o,
+                     [&](const std::int32_t* f, const T* xr, index row, index i0, index i1, const T* dc) {
+                       // (a step's weights from the array on the bottom plane only: two copies
+                       // for the step kinds, one for the others)
+                       if (is_step(K) && !dc)
+                         stencil_range<K, T, true>(v.groups, f, dc, xr, o, x, row, N, i0, i1, lead);
+                       else
+                         stencil_range<K, T, !is_step(K)>(v.groups, f, dc, xr, o, x, row, N, i0, i1, lead);
+                     });
   });
 }
 

@@ -20,10 +20,13 @@ enum : std::uint8_t { kHasL = 1, kHasR = 2, kDropL = 4, kDropR = 8, kSelf = 16 }
 
 // One node row (iz, iy) of an apply of x (apply_out.hpp: y = K x, b - K x
 // or a Chebyshev step; K = kind(out)) over its x-runs: a run of nodes on a constrained face
-// (or the whole row on one) is the identity there (v = x); every other run
-// hands its stencil (f = first + 7 s), x offset to the row's first node, and
-// that node's index to run(f, xr, row, i0, i1). The banded apply and its row
-// form differ only in `run` and in how rows are launched.
+// (or the whole row on one) is the identity there (v = x, a step's weight
+// 1); every other run
+// hands its stencil (f = first + 7 s), x offset to the row's first node,
+// that node's index and the step's Jacobi weights of its class (dc =
+// inv_center + 3 s; null on the bottom plane: dinv_at) to run(f, xr, row,
+// i0, i1, dc). The banded apply and its row form differ only in `run` and
+// in how rows are launched.
 template <OutKind K, class T, class Run>
 inline void sweep_row(const StencilView<T>& k, index nx, index ny, index N, index iz, index iy, const T* x,
                       const ApplyOut<T> out, const Run& run) {
@@ -34,13 +37,14 @@ inline void sweep_row(const StencilView<T>& k, index nx, index ny, index N, inde
   for (index r = 0; r < k.nruns; ++r) {
     const index i0 = k.run_begin[r], i1 = k.run_begin[r + 1];
     const std::uint8_t cx = k.cls[0][i0];
-    if (row_fixed || (cx & kSelf)) {
+    if (row_fixed || (cx & kSelf)) {  // (the identity's rows: a step's weight 1)
       for (int a = 0; a < 3; ++a)
 #pragma omp simd
-        for (index i = i0; i < i1; ++i) put<K>(out, x, a * N + row + i, xr[a * N + i]);
+        for (index i = i0; i < i1; ++i) put<K>(out, x, a * N + row + i, xr[a * N + i], T(1));
       continue;
     }
-    run(k.first + 7 * k.slot[(cx * 32 + cy) * 32 + cz], xr, row, i0, i1);
+    const std::int32_t s = k.slot[(cx * 32 + cy) * 32 + cz];
+    run(k.first + 7 * s, xr, row, i0, i1, iz == 0 ? nullptr : k.inv_center + 3 * s);
   }
 }
 

@@ -187,8 +187,9 @@ TEST(ElasticityApply, ChebyshevStepIsTheResidualAndTheUpdateInOneSweep) {
         const ElasticityStencil k = build_elasticity_stencil(g, faces, 1.0, 0.3);
         const index n = k.size(), N = g.nodes();
         const auto x = random_vector(n, 31), b = random_vector(n, 32), p0 = random_vector(n, 33);
-        auto dinv = random_vector(n, 34);
-        for (real& v : dinv) v = 1 + std::abs(v);
+        std::vector<real> diag(n);
+        elasticity_diagonal_ref(k, diag.data());
+        const std::vector<real> dinv = test::step_weights(g, faces, diag, 34);
         std::vector<real> r(n);
         elasticity_apply_ref(k, x.data(), r.data(), 0, g.nz(), b.data());
         const RowBlock blocks[] = {{0, g.nz(), 0, g.ny()}, {g.nz() / 2, g.nz(), g.ny() / 2, g.ny()}};
@@ -370,7 +371,8 @@ TEST(BottomBlock, OptimisedEqualsReferenceAndAssembly) {
   for (index i = 0; i < A.size(); ++i) err = std::max(err, std::abs(r[i] - (b[i] - ye[i])));
   EXPECT_LT(err, 1e-12 * ye.cwiseAbs().maxCoeff());
   // the smoother's fused Chebyshev step with the block: y = x + s (x - y) + t dinv r
-  auto dinv = random_vector(A.size(), 24), p0 = random_vector(A.size(), 25);
+  const std::vector<real> dinv = test::step_weights(g, kFaceX0, A.diagonal().to_vector(), 24);
+  const auto p0 = random_vector(A.size(), 25);
   std::vector<real> ys = p0;
   A.chebyshev_step(b.data(), x.data(), ys.data(), dinv.data(), 0.6, 0.4);
   real err_y = 0;

@@ -369,7 +369,9 @@ TEST(Device, StencilApplyOnTheDeviceMatchesTheHost) {
     for (unsigned faces : {0u, unsigned(kFaceX0 | kFaceZ0)}) {
       const ElasticityStencil k = build_elasticity_stencil(g, faces, 1.0, 0.3);
       const auto x = test::random_vector(k.size(), 8), b = test::random_vector(k.size(), 9);
-      const auto dinv = test::random_vector(k.size(), 10), p0 = test::random_vector(k.size(), 11);
+      std::vector<real> diag(k.size());
+      elasticity_diagonal_ref(k, diag.data());
+      const auto dinv = test::step_weights(g, faces, diag, 10), p0 = test::random_vector(k.size(), 11);
       const RowBlock all{0, g.nz(), 0, g.ny()};
       std::vector<real> hy(k.size()), hr(k.size()), hs = p0;  // (the step's y: the iterate before x)
       elasticity_apply(k, x.data(), hy.data(), all);

@@ -47,6 +47,25 @@ inline std::vector<real> random_vector(index n, std::uint64_t seed = 1) {
   return v;
 }
 
+// Jacobi weights for the smoother's fused step (kernels/apply_out.hpp): 1 / d
+// (d: the operator's diagonal, 1 on constrained nodes) where the step takes
+// them from the stencil, and other values (1 + |random|) where it reads them
+// from the array, on the bottom plane's free nodes: a test then sees which
+// it used
+inline std::vector<real> step_weights(const GridDims& g, unsigned faces, const std::vector<real>& d,
+                                      std::uint64_t seed) {
+  std::vector<real> w = random_vector(index(d.size()), seed);
+  const index N = g.nodes();
+  for (index iz = 0; iz < g.nz(); ++iz)
+    for (index iy = 0; iy < g.ny(); ++iy)
+      for (index ix = 0; ix < g.nx(); ++ix)
+        for (int a = 0; a < 3; ++a) {
+          const index j = a * N + g.node(ix, iy, iz);
+          w[j] = iz == 0 && !node_constrained(g, faces, ix, iy, iz) ? 1 + std::abs(w[j]) : 1 / d[j];
+        }
+  return w;
+}
+
 // for std::vector and Field alike
 template <class Vec>
 real max_abs(const Vec& v) {
