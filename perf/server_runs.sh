@@ -14,15 +14,17 @@
 #   ranks     scaling --ranks 1,2,4,8,16 on level 12
 #   roofline  roofline --level 12 with all cores: every kernel against the triad
 #   large     levels 13 and 14 with all cores, then level 15 (memory
-#             estimate, progress lines, time, peak memory)
+#             estimate, progress lines, time, peak memory; where OUT is set,
+#             each run's JSON report, its time by kernel, as $OUT/large_L.json)
 #   profile   where the threads' time goes: level 12's kernel profile with 1
 #             thread and with all cores (with the fork/join census and the
 #             memory made), and the price of one parallel region
 #   isa       the apply in each instruction-set variant the CPU runs
 #             (TRESCA_ISA: kernels/isa.hpp) on 1 thread and all cores,
 #             double and float, and level 12 with each: which is faster there
-# LEVEL, LEVELS, SWEEP and THREADS replace 12, 10-12, 1,2,4,8,16 and the
-# core count (e.g. LEVEL=4 LEVELS=3-4 SWEEP=1,2 to try it on 2 cores).
+# LEVEL, LEVELS, SWEEP, LARGE and THREADS replace 12, 10-12, 1,2,4,8,16,
+# "13 14 15" and the core count (e.g. LEVEL=4 LEVELS=3-4 SWEEP=1,2 LARGE=4
+# to try it on 2 cores).
 # Each stage prints what it ran (command, date, machine) before its figures:
 # paste them into perf/RESULTS.md as they are.
 set -euo pipefail
@@ -73,9 +75,11 @@ case $stage in
   roofline)
     TAIL=30 run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores "$b/bin/roofline" --level "$L" ;;
   large)
-    for level in 13 14 15; do
+    for level in ${LARGE:-13 14 15}; do
+      report=()
+      [ -n "${OUT:-}" ] && report=(--json "$OUT/large_$level.json")
       KEEP="$solve|estimated|converged|nested:|^  it " run env OMP_NUM_THREADS="$T" OMP_PROC_BIND=close OMP_PLACES=cores \
-        "$b/bin/tresca" --level "$level"
+        "$b/bin/tresca" --level "$level" "${report[@]}"
     done ;;
   profile)
     for t in 1 "$T"; do
