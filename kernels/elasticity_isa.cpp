@@ -48,25 +48,14 @@ inline void accumulate(const StencilGroupT<T>* g, const StencilGroupT<T>* ge, co
 // xr = x + row. The first `done` entries are computed but not put (they
 // were: a Chebyshev step's put may not run twice on an entry). Always
 // inlined: GCC otherwise calls the smoother step's copy once a block, and
-// the fused step at level 12 runs 5-12 % slower (RESULTS.md §0zj). A step's
-// weights come from the array (kArray: the bottom plane) or are the class's
-// dc (apply_out.hpp: dinv_at, here with its source known when compiled: a
-// test per entry cost the step a tenth on one core, RESULTS.md §0zn).
-template <OutKind K, class T, int W, bool kArray>
+// the fused step at level 12 runs 5-12 % slower (RESULTS.md §0zj). dc: the
+// step's weights of the run's class, or null (apply_out.hpp: dinv_at).
+template <OutKind K, class T, int W>
 __attribute__((always_inline)) inline void stencil_block(const StencilGroupT<T>* g, const std::int32_t* f,
                                                          const T* dc, const T* xr, const ApplyOut<T> o, const T* x,
                                                          index row, index N, index i, int done = 0) {
   using V = Vec<T>;
   constexpr int kLanes = Simd<T>::lanes;
-  auto weight = [&](auto u, int a, index j) {
-    using U = decltype(u);
-    if constexpr (!is_step(K))
-      return U{};
-    else if constexpr (kArray)
-      return load_as<U>(o.dinv + j);
-    else
-      return U{} + dc[a];  // (a broadcast load: weights held in registers across the block spilled its sums)
-  };
   if constexpr (W % kLanes != 0) {
     // scalar path for runs shorter than one vector
     for (int l = 0; l < W; ++l) {
@@ -75,7 +64,7 @@ __attribute__((always_inline)) inline void stencil_block(const StencilGroupT<T>*
         for (int a = 0; a < 3; ++a) acc[a] += q->c[a] * xr[i + l + q->off];
       for (int a = 0; a < 3; ++a) {
         const index j = a * N + row + i + l;
-        put<K>(o, x, j, acc[a], weight(T{}, a, j));
+        put<K>(o, x, j, acc[a], dinv_at<K, T>(o, dc, a, j));
       }
     }
   } else {
@@ -97,21 +86,21 @@ __attribute__((always_inline)) inline void stencil_block(const StencilGroupT<T>*
       const auto keep = lane < T(done);
       for (int a = 0; a < 3; ++a) {
         const index j = a * N + row + i;
-        put_lanes<K>(o, x, j, out[a][0], weight(V{}, a, j), keep);
+        put_lanes<K>(o, x, j, out[a][0], dinv_at<K, V>(o, dc, a, j), keep);
       }
       return;
     }
     for (int a = 0; a < 3; ++a)
       for (int l = 0; l < NV; ++l) {
         const index j = a * N + row + i + kLanes * l;
-        put<K>(o, x, j, out[a][l], weight(V{}, a, j));
+        put<K>(o, x, j, out[a][l], dinv_at<K, V>(o, dc, a, j));
       }
   }
 }
 
 // `lead`: the offset from a node to its input that no row before it in the
 // band's order read (one plane and one row on: apply_band)
-template <OutKind K, class T, bool kArray>
+template <OutKind K, class T>
 inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, const T* dc, const T* xr,
                           const ApplyOut<T> o, const T* x, index row, index N, index i0, index i1, index lead) {
   constexpr int kLanes = Simd<T>::lanes;
@@ -133,19 +122,19 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
         __builtin_prefetch(xr + lead + j);
         if constexpr (is_step(K)) {
           __builtin_prefetch(o.b + row + j);
-          if constexpr (kArray) __builtin_prefetch(o.dinv + row + j);
+          if (!dc) __builtin_prefetch(o.dinv + row + j);
           if constexpr (K == OutKind::step) __builtin_prefetch(o.y + row + j, 1);
         }
       }
-    stencil_block<K, T, kW, kArray>(g, f, dc, xr, o, x, row, N, i);
+    stencil_block<K, T, kW>(g, f, dc, xr, o, x, row, N, i);
   }
-  for (; i + kLanes <= i1; i += kLanes) stencil_block<K, T, kLanes, kArray>(g, f, dc, xr, o, x, row, N, i);
+  for (; i + kLanes <= i1; i += kLanes) stencil_block<K, T, kLanes>(g, f, dc, xr, o, x, row, N, i);
   if (i < i1 && i1 - i0 >= kLanes) {
     // finish with one overlapping vector: computes a few entries again, puts the new ones
-    stencil_block<K, T, kLanes, kArray>(g, f, dc, xr, o, x, row, N, i1 - kLanes, int(i - (i1 - kLanes)));
+    stencil_block<K, T, kLanes>(g, f, dc, xr, o, x, row, N, i1 - kLanes, int(i - (i1 - kLanes)));
     return;
   }
-  for (; i < i1; ++i) stencil_block<K, T, 1, kArray>(g, f, dc, xr, o, x, row, N, i);
+  for (; i < i1; ++i) stencil_block<K, T, 1>(g, f, dc, xr, o, x, row, N, i);
 }
 
 }  // namespace
@@ -162,12 +151,7 @@ void apply_band(const StencilView<T>& v, const T* x, const ApplyOut<T>& o, const
       for (index iy = rows.y_begin; iy < rows.y_end; ++iy)
         sweep_row<K>(v, nx, ny, N, iz, iy, x, o,
                      [&](const std::int32_t* f, const T* xr, index row, index i0, index i1, const T* dc) {
-                       // (a step's weights from the array on the bottom plane only: two copies
-                       // for the step kinds, one for the others)
-                       if (is_step(K) && !dc)
-                         stencil_range<K, T, true>(v.groups, f, dc, xr, o, x, row, N, i0, i1, lead);
-                       else
-                         stencil_range<K, T, !is_step(K)>(v.groups, f, dc, xr, o, x, row, N, i0, i1, lead);
+                       stencil_range<K, T>(v.groups, f, dc, xr, o, x, row, N, i0, i1, lead);
                      });
   });
 }
