@@ -9,6 +9,7 @@
 //   the residual   y_j = b_j - v                            residual_out(b, y)
 //   a Chebyshev    r_j = b_j - v (never stored),            chebyshev_out(b, dinv, s, t, y)
 //   step           y_j = x_j + s (x_j - y_j) + t dinv_j r_j
+//   ... from zero  y_j = x_j + s x_j + t dinv_j r_j          chebyshev_out(b, dinv, s, t, y, true)
 //
 // The last is the multigrid smoother's step fused into the apply
 // (core/multigrid/smoothing.hpp) in the three-term form of the Chebyshev
@@ -23,8 +24,10 @@
 // separate update would write r and read it back, and read and write x
 // once more; and where the two-term form (d = s d + t dinv r, y = x + d)
 // with dinv as an array streamed dinv and d as well: 4 streams instead of
-// 7 (RESULTS.md §0zn) and of 10 (§0p). Where s == 0 (the first step) y is
-// not read, so it may hold anything.
+// 7 (RESULTS.md §0zn) and of 10 (§0p). Where the iterate before x is zero
+// (the second step from a zero guess) or s == 0 (a first step), y is not
+// read, so it may hold anything: 3 streams, and the step before need not
+// have written zeros into y.
 //
 // U is T or a vector of T (simd.hpp): put(), put_lanes() and add() load and
 // store U at p + j, so the CPU's explicit vectors and the device's scalar
@@ -42,6 +45,7 @@ struct ApplyOut {
   const T* b = nullptr;     // the residual's and the step's right-hand side
   const T* dinv = nullptr;  // the step's (read where the header says); set with s and t
   T s = 0, t = 0;
+  bool prev_zero = false;  // the step's iterate before x is zero: y not read
 };
 
 template <class T>
@@ -53,8 +57,8 @@ ApplyOut<T> residual_out(const T* b, T* y) {
   return {y, b};
 }
 template <class T>
-ApplyOut<T> chebyshev_out(const T* b, const T* dinv, T s, T t, T* y) {
-  return {y, b, dinv, s, t};
+ApplyOut<T> chebyshev_out(const T* b, const T* dinv, T s, T t, T* y, bool prev_zero = false) {
+  return {y, b, dinv, s, t, prev_zero};
 }
 
 // Everything that computes with an ApplyOut has internal linkage (an unnamed
@@ -74,11 +78,14 @@ inline void store_as(T* p, U v) {
 
 // The four things put() can do, known when the kernel is compiled: each
 // apply dispatches once on kind(out), so its inner loops carry no branch on
-// it (with_kind).
-enum class OutKind { value, residual, step_first, step };
+// it (with_kind). step_from_zero: a step that does not read y (the iterate
+// before x zero, or s == 0).
+enum class OutKind { value, residual, step_from_zero, step };
 template <class T>
 constexpr OutKind kind(const ApplyOut<T>& o) {
-  return o.dinv ? (o.s != 0 ? OutKind::step : OutKind::step_first) : o.b ? OutKind::residual : OutKind::value;
+  return o.dinv ? (o.s != 0 && !o.prev_zero ? OutKind::step : OutKind::step_from_zero)
+                : o.b ? OutKind::residual
+                      : OutKind::value;
 }
 template <OutKind K>
 using Kind = std::integral_constant<OutKind, K>;
@@ -88,12 +95,12 @@ inline void with_kind(const ApplyOut<T>& o, const F& f) {
   switch (kind(o)) {
     case OutKind::value: return f(Kind<OutKind::value>{});
     case OutKind::residual: return f(Kind<OutKind::residual>{});
-    case OutKind::step_first: return f(Kind<OutKind::step_first>{});
+    case OutKind::step_from_zero: return f(Kind<OutKind::step_from_zero>{});
     case OutKind::step: return f(Kind<OutKind::step>{});
   }
 }
 
-constexpr bool is_step(OutKind k) { return k == OutKind::step_first || k == OutKind::step; }
+constexpr bool is_step(OutKind k) { return k == OutKind::step_from_zero || k == OutKind::step; }
 
 // The step's dinv_j for entry j of component a of a run of free nodes: the
 // run's class's weights (dc: the stencil's inv_center of that class, its 3
@@ -117,9 +124,9 @@ inline void put(const ApplyOut<T> o, const T* x, index j, U v, U dj) {
     store_as<U>(o.y + j, load_as<U>(o.b + j) - v);
   } else {
     const U xj = load_as<U>(x + j);
-    U yn = xj + o.t * dj * (load_as<U>(o.b + j) - v);
-    if constexpr (K == OutKind::step) yn += o.s * (xj - load_as<U>(o.y + j));
-    store_as<U>(o.y + j, yn);
+    const U yn = xj + o.t * dj * (load_as<U>(o.b + j) - v);
+    // (s (x - 0) is s x bit for bit; s == 0 adds a zero)
+    store_as<U>(o.y + j, yn + o.s * (K == OutKind::step ? xj - load_as<U>(o.y + j) : xj));
   }
 }
 
@@ -149,7 +156,8 @@ inline void add(const ApplyOut<T> o, index j, U w) {
 }  // namespace
 
 // Cost per node of a Chebyshev step beyond the residual's: reads y's
-// previous values (3 dofs, double; dinv is the class's, in cache), 6 flops a dof
-constexpr Cost kChebStepExtraCost{24, 18};
+// previous values (3 dofs, double; dinv is the class's, in cache), 6 flops a
+// dof; from zero, the flops only
+constexpr Cost kChebStepExtraCost{24, 18}, kChebStepFromZeroExtraCost{0, 18};
 
 }  // namespace tresca

@@ -94,15 +94,22 @@ ElasticityStencilT<T> stencil_in_precision(const ElasticityStencil& k);
 // y = K x reads x and writes y (3 components each; neighbour rows come from
 // cache), 153 FMAs; the residual b - K x also reads b.
 // The smoother's Chebyshev step (apply_out.hpp) writes the new iterate over
-// the one before x, which it also reads (kChebStepExtraCost; its Jacobi
-// weights come from the stencil's inv_center, in cache).
+// the one before x, which it also reads unless that one is zero
+// (kChebStepExtraCost, kChebStepFromZeroExtraCost; its Jacobi weights come
+// from the stencil's inv_center, in cache).
 constexpr Cost kApplyCost{48, 306};
 constexpr Cost kResidualCost{72, 309};
 constexpr Cost kChebStepCost = kResidualCost + kChebStepExtraCost;
+constexpr Cost kChebStepFromZeroCost = kResidualCost + kChebStepFromZeroExtraCost;
 template <class T>
 constexpr Cost apply_cost(const ApplyOut<T>& out) {
-  const OutKind k = kind(out);
-  return is_step(k) ? kChebStepCost : k == OutKind::residual ? kResidualCost : kApplyCost;
+  switch (kind(out)) {
+    case OutKind::step: return kChebStepCost;
+    case OutKind::step_from_zero: return kChebStepFromZeroCost;
+    case OutKind::residual: return kResidualCost;
+    case OutKind::value: break;
+  }
+  return kApplyCost;
 }
 
 // y = K x for output planes iz in [z_begin, z_end) (the whole grid with

@@ -123,7 +123,7 @@ inline void stencil_range(const StencilGroupT<T>* g, const std::int32_t* f, cons
         if constexpr (is_step(K)) {
           __builtin_prefetch(o.b + row + j);
           if (!dc) __builtin_prefetch(o.dinv + row + j);
-          if constexpr (K == OutKind::step) __builtin_prefetch(o.y + row + j, 1);
+          __builtin_prefetch(o.y + row + j, 1);  // (for writing, also where the step does not read it)
         }
       }
     stencil_block<K, T, kW>(g, f, dc, xr, o, x, row, N, i);

@@ -22,39 +22,65 @@ inline real hsum(V v) {
   for (index l = 0; l < kL; ++l) s += v[l];
   return s;
 }
-// kL entries from p as doubles (floats widened)
+// kL entries from p as doubles (floats widened), and stored as floats
+typedef float HalfV __attribute__((vector_size(kSimdBytes / 2), aligned(alignof(float)), may_alias));
 inline V load_real(const real* p) { return load(p); }
-inline V load_real(const float* p) {
-  typedef float H __attribute__((vector_size(kSimdBytes / 2), aligned(alignof(float)), may_alias));
-  return __builtin_convertvector(*reinterpret_cast<const H*>(p), V);
-}
+inline V load_real(const float* p) { return __builtin_convertvector(*reinterpret_cast<const HalfV*>(p), V); }
+inline void store_float(float* p, V v) { *reinterpret_cast<HalfV*>(p) = __builtin_convertvector(v, HalfV); }
 
-// The sum over [i0, i1) of x_i y_i, or with weights w of x_i (w_i y_i), in
-// double: a reduction's block on the host
-template <bool Weighted, class T>
-real block_dot(index i0, index i1, const T* x, const T* w, const T* y) {
-  auto term = [=](index i) {
-    if constexpr (Weighted)
-      return load_real(x + i) * (load_real(w + i) * load_real(y + i));
-    else
-      return load_real(x + i) * load_real(y + i);
-  };
+// The sum over [i0, i1) of products in double, in the dot's order (a
+// reduction's block on the host): two vector sums over pairs of vectors,
+// then one, then the scalar tail. vterm(i) gives the factors of the kL
+// products from i, sterm(i) those of one; a term may store as it goes (the
+// CG's fused starts). The products are added here only, each fused
+// (std::fma in the tail; GCC contracts the vectors' a * b + s the same way
+// in every instance), so that a term whose factors are dot's gives dot's bits.
+struct VFactors {  // of kL products
+  V a, b;
+};
+struct Factors {  // of one
+  real a, b;
+};
+template <class VTerm, class STerm>
+real block_sum(index i0, index i1, const VTerm& vterm, const STerm& sterm) {
   V s0{}, s1{};
+  auto add = [&](V& s, index i) {
+    const auto [a, b] = vterm(i);
+    s += a * b;
+  };
   index i = i0;
   for (; i + 2 * kL <= i1; i += 2 * kL) {
-    s0 += term(i);
-    s1 += term(i + kL);
+    add(s0, i);
+    add(s1, i + kL);
   }
-  for (; i + kL <= i1; i += kL) s0 += term(i);
+  for (; i + kL <= i1; i += kL) add(s0, i);
   real s = hsum(s0 + s1);
-  for (; i < i1; ++i) s += real(x[i]) * (Weighted ? real(w[i]) * real(y[i]) : real(y[i]));
+  for (; i < i1; ++i) {
+    const auto [a, b] = sterm(i);
+    s = std::fma(a, b, s);
+  }
   return s;
 }
 
-template <class T>
-real dot(index n, const T* x, const T* y) {
-  return sum_over_blocks(precision_name<T>("dot", "dot (float)"), n, kDotBlock, in_precision<T>(kDotCost),
-                         [x, y](index i0, index i1) { return block_dot<false>(i0, i1, x, x, y); },
+// The sum over [i0, i1) of x_i y_i, or with weights w of x_i (w_i y_i)
+template <bool Weighted, class TX, class T>
+real block_dot(index i0, index i1, const TX* x, const T* w, const T* y) {
+  return block_sum(
+      i0, i1,
+      [=](index i) {
+        if constexpr (Weighted)
+          return VFactors{load_real(x + i), load_real(w + i) * load_real(y + i)};
+        else
+          return VFactors{load_real(x + i), load_real(y + i)};
+      },
+      [=](index i) { return Factors{real(x[i]), Weighted ? real(w[i]) * real(y[i]) : real(y[i])}; });
+}
+
+template <class TX, class TY>
+real dot(index n, const TX* x, const TY* y) {
+  const char* name = sizeof(TX) == sizeof(TY) ? precision_name<TY>("dot", "dot (float)") : "dot (double, float)";
+  return sum_over_blocks(name, n, kDotBlock, Cost{double(sizeof(TX) + sizeof(TY)), kDotCost.flops},
+                         [x, y](index i0, index i1) { return block_dot<false>(i0, i1, x, y, y); },
                          [x, y](index i) { return real(x[i]) * real(y[i]); });
 }
 
@@ -72,6 +98,10 @@ void axpy(index n, real a, const real* x, real* y) {
 }
 void xpay(index n, const real* x, real a, real* y) {
   for_each_entry("xpay", n, kXpayCost, [=](index i) { y[i] = x[i] + a * y[i]; });
+}
+void xpay(index n, const float* x, real a, real* y) {
+  for_each_entry("xpay (float x)", n, Cost{kXpayCost.bytes - 4, kXpayCost.flops},
+                 [=](index i) { y[i] = real(x[i]) + a * y[i]; });
 }
 void copy(index n, const real* x, real* y) {
   for_each_entry("copy", n, kCopyCost, [=](index i) { y[i] = x[i]; });
@@ -116,28 +146,91 @@ void scale(const ComponentRuns& r, real a, real* y) {
   for_each_component_entry("scale (component runs)", r, kScaleCost, [=](index k) { y[k] *= a; });
 }
 
-real cg_update(index n, real a, const real* p, const real* q, real* x, real* r) {
+namespace {
+// cg_update, and where r_low is not null r's float copy with it
+template <bool kLow>
+real cg_update_in(const char* kernel, Cost cost, index n, real a, const real* p, const real* q, real* x, real* r,
+                  float* r_low) {
   // fused in blocks so that r is still in cache (registers) when r.r is formed
-  return sum_over_blocks("cg update", n, kDotBlock, kCgUpdateCost, [=](index i0, index i1) {
+  return sum_over_blocks(kernel, n, kDotBlock, cost, [=](index i0, index i1) {
     V s0{};
     index i = i0;
     for (; i + kL <= i1; i += kL) {
       store(x + i, load(x + i) + a * load(p + i));
       const V ri = load(r + i) - a * load(q + i);
       store(r + i, ri);
+      if constexpr (kLow) store_float(r_low + i, ri);
       s0 += ri * ri;
     }
     real s = hsum(s0);
     for (; i < i1; ++i) {
       x[i] += a * p[i];
       r[i] -= a * q[i];
+      if constexpr (kLow) r_low[i] = float(r[i]);
       s += r[i] * r[i];
     }
     return s;
   }, [=](index i) {
     x[i] += a * p[i];
     r[i] -= a * q[i];
+    if constexpr (kLow) r_low[i] = float(r[i]);
     return r[i] * r[i];
+  });
+}
+}  // namespace
+
+real cg_update(index n, real a, const real* p, const real* q, real* x, real* r) {
+  return cg_update_in<false>("cg update", kCgUpdateCost, n, a, p, q, x, r, nullptr);
+}
+real cg_update(index n, real a, const real* p, const real* q, real* x, real* r, float* r_low) {
+  return cg_update_in<true>("cg update (and r in float)", kCgUpdateCost + Cost{4, 0}, n, a, p, q, x, r, r_low);
+}
+
+namespace {
+template <bool kQ, bool kLow>
+real cg_start_in(index n, const real* b, const real* q, real* r, float* r_low) {
+  const char* name = kQ ? (kLow ? "cg start (r = b - q, and in float)" : "cg start (r = b - q)")
+                        : (kLow ? "cg start (r = b, and in float)" : "cg start (r = b)");
+  const Cost cost{(kQ ? 24.0 : 16.0) + (kLow ? 4.0 : 0.0), kQ ? 3.0 : 2.0};
+  return sum_over_blocks(name, n, kDotBlock, cost, [=](index i0, index i1) {
+    return block_sum(i0, i1, [=](index i) {
+      const V ri = kQ ? load(b + i) - load(q + i) : load(b + i);
+      store(r + i, ri);
+      if constexpr (kLow) store_float(r_low + i, ri);
+      return VFactors{ri, ri};
+    }, [=](index i) {
+      const real ri = kQ ? b[i] - q[i] : b[i];
+      r[i] = ri;
+      if constexpr (kLow) r_low[i] = float(ri);
+      return Factors{ri, ri};
+    });
+  }, [=](index i) {
+    r[i] = kQ ? b[i] - q[i] : b[i];
+    if constexpr (kLow) r_low[i] = float(r[i]);
+    return r[i] * r[i];
+  });
+}
+}  // namespace
+
+real cg_start(index n, const real* b, const real* q, real* r, float* r_low) {
+  if (q) return r_low ? cg_start_in<true, true>(n, b, q, r, r_low) : cg_start_in<true, false>(n, b, q, r, r_low);
+  return r_low ? cg_start_in<false, true>(n, b, q, r, r_low) : cg_start_in<false, false>(n, b, q, r, r_low);
+}
+
+real cg_first_direction(index n, const real* r, const float* z, real* p) {
+  return sum_over_blocks("cg first direction (p = z, float z)", n, kDotBlock, Cost{20, 2}, [=](index i0, index i1) {
+    return block_sum(i0, i1, [=](index i) {
+      const V pi = load_real(z + i);
+      store(p + i, pi);
+      return VFactors{load(r + i), pi};
+    }, [=](index i) {
+      const real pi = real(z[i]);
+      p[i] = pi;
+      return Factors{r[i], pi};
+    });
+  }, [=](index i) {
+    p[i] = real(z[i]);
+    return r[i] * p[i];
   });
 }
 
@@ -213,12 +306,9 @@ void cheb_update(index n, T s, T t, const T* dinv, const T* r, const T* x, T* y)
 }
 
 template <class T>
-void cheb_first(index n, T t, const T* dinv, const T* b, T* x, T* p) {
+void cheb_first(index n, T t, const T* dinv, const T* b, T* x) {
   const char* name = precision_name<T>("chebyshev first", "chebyshev first (float)");
-  for_each_entry(name, n, in_precision<T>(kChebFirstCost), [=](index i) {
-    x[i] = t * dinv[i] * b[i];
-    p[i] = 0;
-  });
+  for_each_entry(name, n, in_precision<T>(kChebFirstCost), [=](index i) { x[i] = t * dinv[i] * b[i]; });
 }
 
 template <class T>
@@ -231,8 +321,9 @@ void cheb_first_on_guess(index n, T t, const T* dinv, T* r, T* x) {
   });
 }
 
-template real dot<double>(index, const double*, const double*);
-template real dot<float>(index, const float*, const float*);
+template real dot<double, double>(index, const double*, const double*);
+template real dot<float, float>(index, const float*, const float*);
+template real dot<double, float>(index, const double*, const float*);
 template real dot_ref<double>(index, const double*, const double*);
 template real dot_ref<float>(index, const float*, const float*);
 template real jacobi_cg_update<double>(index, double, const double*, const double*, double*);
@@ -253,8 +344,8 @@ template void gather_from<double, double>(index, const index*, const double*, do
 template void gather_from<double, float>(index, const index*, const float*, double*);
 template void cheb_update<double>(index, double, double, const double*, const double*, const double*, double*);
 template void cheb_update<float>(index, float, float, const float*, const float*, const float*, float*);
-template void cheb_first<double>(index, double, const double*, const double*, double*, double*);
-template void cheb_first<float>(index, float, const float*, const float*, float*, float*);
+template void cheb_first<double>(index, double, const double*, const double*, double*);
+template void cheb_first<float>(index, float, const float*, const float*, float*);
 template void cheb_first_on_guess<double>(index, double, const double*, double*, double*);
 template void cheb_first_on_guess<float>(index, float, const float*, float*, float*);
 

@@ -7,8 +7,10 @@
 // Cost models (bytes moved, flops), n entries of 8 bytes:
 //   dot 16n B, 2n F;  axpy 24n B, 2n F;  xpay 24n B, 2n F;  triad 24n B, 2n F;
 //   cg_update (x += a p, r -= a q, returns r.r) 48n B, 6n F;
+//   (the CG's float copies: dot of double and float 12n B, xpay from a
+//   float x 20n B, cg_update writing r in float too 52n B)
 //   cheb_update (y = x + t Dinv r + s (x - y)) 40n B, 6n F;
-//   cheb_first (x = t Dinv b, p = 0) 32n B, 2n F;
+//   cheb_first (x = t Dinv b) 24n B, 2n F;
 //   cheb_first_on_guess ((x, r) = (x + t Dinv r, x)) 40n B, 3n F;
 //   jacobi_cg_update (r -= a q, returns r.(Dinv r)) 32n B, 5n F;
 //   jacobi_xpay (p = Dinv r + b p) 32n B, 3n F.
@@ -22,16 +24,17 @@ namespace tresca {
 constexpr index kDotBlock = 4096;
 // per entry (the table above)
 constexpr Cost kDotCost{16, 2}, kAxpyCost{24, 2}, kXpayCost{24, 2}, kCgUpdateCost{48, 6}, kChebUpdateCost{40, 6},
-    kChebFirstCost{32, 2}, kChebFirstOnGuessCost{40, 3}, kCopyCost{16, 0}, kFillCost{8, 0}, kScaleCost{16, 1},
+    kChebFirstCost{24, 2}, kChebFirstOnGuessCost{40, 3}, kCopyCost{16, 0}, kFillCost{8, 0}, kScaleCost{16, 1},
     kHadamardCost{24, 1}, kTriadCost{24, 2}, kJacobiCgUpdateCost{32, 5}, kJacobiXpayCost{32, 3};
 
-template <class T>
-real dot(index n, const T* x, const T* y);  // T = double, float
+template <class TX, class TY>
+real dot(index n, const TX* x, const TY* y);  // (TX, TY) = (double, double), (float, float), (double, float)
 template <class T>
 real dot_ref(index n, const T* x, const T* y);
 real norm2(index n, const real* x);
 void axpy(index n, real a, const real* x, real* y);        // y += a x
 void xpay(index n, const real* x, real a, real* y);        // y = x + a y
+void xpay(index n, const float* x, real a, real* y);       // the same with x widened: 20n B
 void copy(index n, const real* x, real* y);                // y = x
 template <class T>
 void fill(index n, T v, T* y);                             // y = v (T = double, float)
@@ -63,6 +66,15 @@ template <class To>
 void reciprocal_or_zero(index n, const real* x, To* y);
 // x += a p; r -= a q; returns r.r
 real cg_update(index n, real a, const real* p, const real* q, real* x, real* r);
+// the same, and r_low = float(r) (a single-precision preconditioner's
+// input): 52n B
+real cg_update(index n, real a, const real* p, const real* q, real* x, real* r, float* r_low);
+// CG's start: r = b - q (b where q is null) and, where r_low is not null,
+// r_low = float(r); returns r.r, the bits of dot(n, r, r): 16n-28n B
+real cg_start(index n, const real* b, const real* q, real* r, float* r_low);
+// CG's first direction from a preconditioner's float z: p = z (widened);
+// returns r.p, the bits of dot(n, r, p): 20n B
+real cg_first_direction(index n, const real* r, const float* z, real* p);
 real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real* r);
 // Jacobi-preconditioned CG without its iterate (the Lanczos estimate of
 // the smoother's lmax, core/multigrid/smoothing.hpp; T = double, float):
@@ -82,9 +94,10 @@ void jacobi_xpay(index n, const T* dinv, const T* r, T b, T* p);
 // bench_kernels' ChebStepUnfused reference)
 template <class T>
 void cheb_update(index n, T s, T t, const T* dinv, const T* r, const T* x, T* y);
-// the first step from x_0 = 0: x = t dinv .* b, and p = x_0 = 0 for the next
+// the first step from x_0 = 0: x = t dinv .* b (the next step is told
+// that x_0 = 0: chebyshev_out's prev_zero)
 template <class T>
-void cheb_first(index n, T t, const T* dinv, const T* b, T* x, T* p);
+void cheb_first(index n, T t, const T* dinv, const T* b, T* x);
 // the first step from a guess x with r = b - A x: x += t dinv .* r (as
 // cheb_update with s = 0, bit for bit), and r = the guess, x_0 for the next
 template <class T>

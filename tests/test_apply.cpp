@@ -195,38 +195,43 @@ TEST(ElasticityApply, ChebyshevStepIsTheResidualAndTheUpdateInOneSweep) {
         const RowBlock blocks[] = {{0, g.nz(), 0, g.ny()}, {g.nz() / 2, g.nz(), g.ny() / 2, g.ny()}};
         for (const RowBlock& rows : blocks)
           for (real s : {0.0, 0.8})
-            for (bool row_form : {false, true}) {
-              // y holds the iterate before x (not read where s == 0: NaN there)
-              std::vector<real> y = p0;
-              if (s == 0) std::fill(y.begin(), y.end(), std::numeric_limits<real>::quiet_NaN());
-              const std::vector<real> y0 = y;
-              const ApplyOut<real> out = chebyshev_out<real>(b.data(), dinv.data(), s, t, y.data());
-              if (row_form)
-                elasticity_apply_rows(view(k), x.data(), out, rows);
-              else
-                elasticity_apply(k, x.data(), out, rows);
-              real err_y = 0;
-              bool untouched = true;
-              for (index iz = 0; iz < g.nz(); ++iz)
-                for (index iy = 0; iy < g.ny(); ++iy)
-                  for (index ix = 0; ix < g.nx(); ++ix)
-                    for (int a = 0; a < 3; ++a) {
-                      const index j = a * N + g.node(ix, iy, iz);
-                      const bool in = rows.z_begin <= iz && iz < rows.z_end && rows.y_begin <= iy && iy < rows.y_end;
-                      if (!in) {
-                        untouched = untouched && (s == 0 ? std::isnan(y[j]) : y[j] == y0[j]);
-                        continue;
+            for (bool from_zero : {false, true})
+              for (bool row_form : {false, true}) {
+                // y holds the iterate before x (not read where s == 0 or
+                // that iterate is zero: NaN there)
+                const bool unread = s == 0 || from_zero;
+                std::vector<real> y = p0;
+                if (unread) std::fill(y.begin(), y.end(), std::numeric_limits<real>::quiet_NaN());
+                const std::vector<real> y0 = y;
+                const ApplyOut<real> out = chebyshev_out<real>(b.data(), dinv.data(), s, t, y.data(), from_zero);
+                if (row_form)
+                  elasticity_apply_rows(view(k), x.data(), out, rows);
+                else
+                  elasticity_apply(k, x.data(), out, rows);
+                real err_y = 0;
+                bool untouched = true;
+                for (index iz = 0; iz < g.nz(); ++iz)
+                  for (index iy = 0; iy < g.ny(); ++iy)
+                    for (index ix = 0; ix < g.nx(); ++ix)
+                      for (int a = 0; a < 3; ++a) {
+                        const index j = a * N + g.node(ix, iy, iz);
+                        const bool in = rows.z_begin <= iz && iz < rows.z_end && rows.y_begin <= iy && iy < rows.y_end;
+                        if (!in) {
+                          untouched = untouched && (unread ? std::isnan(y[j]) : y[j] == y0[j]);
+                          continue;
+                        }
+                        const real prev = from_zero ? 0 : p0[j];
+                        const real want = x[j] + s * (x[j] - prev) + t * dinv[j] * r[j];
+                        err_y = std::max(err_y, std::abs(y[j] - want));
                       }
-                      const real want = x[j] + (s == 0 ? 0 : s * (x[j] - p0[j])) + t * dinv[j] * r[j];
-                      err_y = std::max(err_y, std::abs(y[j] - want));
-                    }
-              const std::string where = std::to_string(sz[0]) + "x" + std::to_string(sz[1]) + "x" +
-                                        std::to_string(sz[2]) + " faces " + std::to_string(faces) +
-                                        (row_form ? " rows" : " banded") + " s " + std::to_string(s);
-              const real scale = max_abs(r) * 4 + max_abs(x);
-              EXPECT_LT(err_y, 1e-13 * scale) << where;
-              EXPECT_TRUE(untouched) << where;
-            }
+                const std::string where = std::to_string(sz[0]) + "x" + std::to_string(sz[1]) + "x" +
+                                          std::to_string(sz[2]) + " faces " + std::to_string(faces) +
+                                          (row_form ? " rows" : " banded") + " s " + std::to_string(s) +
+                                          (from_zero ? " from zero" : "");
+                const real scale = max_abs(r) * 4 + max_abs(x);
+                EXPECT_LT(err_y, 1e-13 * scale) << where;
+                EXPECT_TRUE(untouched) << where;
+              }
         // single precision: the same step to float rounding
         const auto kf = stencil_in_precision<float>(k);
         std::vector<float> xf(x.begin(), x.end()), bf(b.begin(), b.end()), yf(p0.begin(), p0.end()),

@@ -62,11 +62,14 @@ TEST(Chebyshev, EveryDegreeAndEntryGivesTheTextbookIterate) {
             ++residuals;
             for (index i = 0; i < n; ++i) to[i] = b[i] - A(from, i);
           },
-          [&](real* from, real* to, real s, real t) {
+          [&](real* from, real* to, real s, real t, bool from_zero) {
             ++steps;
             ASSERT_NE(from, to);
-            for (index i = 0; i < n; ++i)  // the three-term form: `to` holds the iterate before `from`
-              to[i] = from[i] + t * dinv[i] * (b[i] - A(from, i)) + (s == 0 ? 0 : s * (from[i] - to[i]));
+            // the three-term form: `to` holds the iterate before `from`,
+            // read unless that is zero (NaN here where no step wrote it)
+            for (index i = 0; i < n; ++i)
+              to[i] = from[i] + t * dinv[i] * (b[i] - A(from, i)) +
+                      (s == 0 ? 0 : s * (from_zero ? from[i] : from[i] - to[i]));
           },
           in);
       for (index i = 0; i < n; ++i)
@@ -274,6 +277,60 @@ TEST(MultigridCG, SinglePrecisionVCycleKeepsIterationsAndAccuracy) {
       EXPECT_LE(std::abs(its[1] - its[0]), 1) << "level " << level << (odd ? " (23x11x13)" : "");
       EXPECT_LT(test::max_abs_diff(u[0], u[1]), 1e-10 * test::max_abs(u[0]));
     }
+}
+
+// A V-cycle in float gives CG its float vectors directly (operator.hpp's
+// works_in_float): apply_in_float is apply rounded, bit for bit, and CG
+// through it takes the same iterates, bit for bit, as CG through apply()
+// (the preconditioner seen as a double operator only); odd mesh included
+TEST(MultigridCG, AFloatVCycleTakesTheCGsFloatVectorsWithTheSameIterates) {
+  struct DoubleOnly : LinearOperator {  // the multigrid without its float interface
+    const Multigrid& mg;
+    explicit DoubleOnly(const Multigrid& m) : mg(m) {}
+    index size() const override { return mg.size(); }
+    void apply(const real* x, real* y) const override { mg.apply(x, y); }
+  };
+  for (const Problem& P : {make_problem(spec_for_level(5)), make_problem(spec_for_dims(23, 11, 13))}) {
+    const index n = P.dofs();
+    MGOptions mo;
+    mo.precision = Precision::single_precision;
+    const Multigrid mg(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
+    ASSERT_TRUE(mg.works_in_float());
+    auto r = test::random_vector(n, 41);
+    zero_constrained(P.grid, P.interior_faces, r.data());
+    std::vector<real> z(n);
+    mg.apply(r.data(), z.data());
+    const std::vector<float> rf(r.begin(), r.end());
+    std::vector<float> zf(n, std::nanf(""));
+    mg.apply_in_float(rf.data(), zf.data());
+    for (index i = 0; i < n; ++i) ASSERT_EQ(zf[i], float(z[i])) << "entry " << i;
+
+    const ElasticityOperator K(P.grid, P.interior_faces, P.spec.E, P.spec.nu);
+    CGOptions o;
+    o.rtol = 1e-10;
+    SolveStats st[2];
+    std::vector<real> u[2];
+    for (int k = 0; k < 2; ++k) {
+      CGWorkspace ws;
+      u[k].assign(n, 0);
+      const DoubleOnly plain(mg);
+      st[k] = pcg(K, k ? static_cast<const LinearOperator*>(&plain) : &mg, r.data(), u[k].data(), o, ws);
+      ASSERT_TRUE(st[k].ok()) << to_string(st[k].reason);
+      EXPECT_EQ(ws.z.size(), k ? std::size_t(n) : 0u);  // (no double z where M works in float)
+    }
+    EXPECT_EQ(st[0].iterations, st[1].iterations);
+    EXPECT_GT(st[0].iterations, 3);
+    EXPECT_EQ(st[0].residual, st[1].residual);
+    for (index i = 0; i < n; ++i) ASSERT_EQ(u[0][i], u[1][i]) << "entry " << i;
+  }
+  // a V-cycle in double has no float interface
+  const Problem P = make_problem(spec_for_level(3));
+  MGOptions mo;
+  mo.precision = Precision::double_precision;
+  const Multigrid md(P.grid, P.interior_faces, P.spec.E, P.spec.nu, mo);
+  EXPECT_FALSE(md.works_in_float());
+  std::vector<float> a(P.dofs()), b(P.dofs());
+  EXPECT_THROW(md.apply_in_float(a.data(), b.data()), std::logic_error);
 }
 
 TEST(MultigridVCycle, IsSymmetricInBothPrecisions) {

@@ -35,6 +35,51 @@ TEST(VectorOps, DotAndCgUpdateMatchReferenceOnAwkwardLengths) {
   }
 }
 
+// the CG's fused kernels (cg.cpp), for a preconditioner that works in
+// float and for its start: each the same bits as the unfused kernels it
+// replaces (dot, xpay and cg_update on the float values widened; a copy or
+// triad and a dot), and each float copy is its vector rounded
+TEST(VectorOps, CgFusedKernelsAreTheirUnfusedFormsBitForBit) {
+  for (index n : kLengths) {
+    const auto r = test::random_vector(n, 11), a = test::random_vector(n, 12), b = test::random_vector(n, 13);
+    std::vector<float> zf(n);
+    std::vector<real> z(n);
+    for (index i = 0; i < n; ++i) z[i] = real(zf[i] = float(a[i]));
+    EXPECT_EQ(dot(n, r.data(), zf.data()), dot(n, r.data(), z.data())) << "n = " << n;
+    auto p1 = b, p2 = b;
+    xpay(n, zf.data(), -0.43, p1.data());
+    xpay(n, z.data(), -0.43, p2.data());
+    for (index i = 0; i < n; ++i) ASSERT_EQ(p1[i], p2[i]) << "n = " << n << ", entry " << i;
+    auto x1 = a, r1 = r, x2 = a, r2 = r;
+    std::vector<float> r_low(n, std::nanf(""));
+    EXPECT_EQ(cg_update(n, 0.37, b.data(), z.data(), x1.data(), r1.data(), r_low.data()),
+              cg_update(n, 0.37, b.data(), z.data(), x2.data(), r2.data()))
+        << "n = " << n;
+    for (index i = 0; i < n; ++i) {
+      ASSERT_EQ(x1[i], x2[i]) << "n = " << n << ", entry " << i;
+      ASSERT_EQ(r1[i], r2[i]) << "n = " << n << ", entry " << i;
+      ASSERT_EQ(r_low[i], float(r2[i])) << "n = " << n << ", entry " << i;
+    }
+    // CG's start: r = b - q or b, its float copy where asked, and r.r with dot's bits
+    for (bool with_q : {false, true})
+      for (bool low : {false, true}) {
+        std::vector<real> r3(n, std::nan(""));
+        std::fill(r_low.begin(), r_low.end(), std::nanf(""));
+        const real rr = cg_start(n, b.data(), with_q ? a.data() : nullptr, r3.data(), low ? r_low.data() : nullptr);
+        for (index i = 0; i < n; ++i) {
+          ASSERT_EQ(r3[i], with_q ? b[i] - a[i] : b[i]) << "n = " << n << ", entry " << i;
+          ASSERT_TRUE(low ? r_low[i] == float(r3[i]) : std::isnan(r_low[i])) << "n = " << n << ", entry " << i;
+        }
+        EXPECT_EQ(rr, dot(n, r3.data(), r3.data())) << "n = " << n;
+      }
+    // CG's first direction: p = z widened, and r.p with dot's bits
+    std::vector<real> p3(n, std::nan(""));
+    const real rp = cg_first_direction(n, r.data(), zf.data(), p3.data());
+    for (index i = 0; i < n; ++i) ASSERT_EQ(p3[i], z[i]) << "n = " << n << ", entry " << i;
+    EXPECT_EQ(rp, dot(n, r.data(), z.data())) << "n = " << n;
+  }
+}
+
 // the Lanczos estimate's kernels (double and float vectors, sums in double)
 // against their _ref twins and the plain loops they fuse
 TEST(VectorOps, JacobiCgStepsMatchReferenceInBothPrecisions) {
@@ -292,13 +337,10 @@ TEST(VectorOps, ChebyshevUpdatesFollowTheirFormulas) {
   auto y = prev;
   cheb_update(n, 0.3, 0.7, dinv.data(), r.data(), x.data(), y.data());
   for (index i = 0; i < n; ++i) ASSERT_NEAR(y[i], x[i] + 0.3 * (x[i] - prev[i]) + 0.7 * dinv[i] * r[i], 1e-14);
-  // from zero: x_1 = t dinv b, x_0 = 0 left for the next step, whatever it held
-  std::vector<real> x1(n, std::nan("")), p(n, std::nan(""));
-  cheb_first(n, 0.5, dinv.data(), r.data(), x1.data(), p.data());
-  for (index i = 0; i < n; ++i) {
-    ASSERT_NEAR(x1[i], 0.5 * dinv[i] * r[i], 1e-15);
-    ASSERT_EQ(p[i], 0.0);
-  }
+  // from zero: x_1 = t dinv b
+  std::vector<real> x1(n, std::nan(""));
+  cheb_first(n, 0.5, dinv.data(), r.data(), x1.data());
+  for (index i = 0; i < n; ++i) ASSERT_NEAR(x1[i], 0.5 * dinv[i] * r[i], 1e-15);
   // from a guess: cheb_update with s = 0, bit for bit, and the guess left where r was
   auto r1 = r, x2 = x;
   std::vector<real> y2 = prev;

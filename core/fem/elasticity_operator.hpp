@@ -49,12 +49,13 @@ class ElasticityOperator : public LinearOperator {
   // a step of the multigrid smoother's Chebyshev iteration fused into the
   // apply (kernels/apply_out.hpp): with r = b - (K + B) x never stored,
   // y = x + s (x - y) + t dinv r, y holding the iterate before x (not read
-  // where s == 0); x's ghost rows as they are, y's zeroed. dinv: this
-  // operator's 1 / diag (K + B), read on the bottom plane only; elsewhere
-  // the stencil's own weights are used, which it must equal (apply_out.hpp)
+  // where from_zero says that one is zero, or s == 0); x's ghost rows as
+  // they are, y's zeroed. dinv: this operator's 1 / diag (K + B), read on
+  // the bottom plane only; elsewhere the stencil's own weights are used,
+  // which it must equal (apply_out.hpp)
   template <class T>
-  void chebyshev_step(const T* b, const T* x, T* y, const T* dinv, T s, T t) const {
-    apply_rows<T>(x, chebyshev_out(b, dinv, s, t, y), 0, slab_.local.nz());
+  void chebyshev_step(const T* b, const T* x, T* y, const T* dinv, T s, T t, bool from_zero = false) const {
+    apply_rows<T>(x, chebyshev_out(b, dinv, s, t, y, from_zero), 0, slab_.local.nz());
   }
   void update_ghosts(real* x) const override { halo_.exchange(x); }
   void update_ghosts(float* x) const { halo_.exchange(x); }

@@ -388,9 +388,9 @@ void Multigrid::smooth(int l, bool zero_guess, const T* in) const {
   chebyshev_smooth<T>(
       A.size(), levels_[l].lmax, opt_.range, opt_.degree, zero_guess, dinv_l, w.bp, w.xp, w.r.data(),
       [&](T* x, T* r) { residual<T>(l, w.bp, x, r); },
-      [&](T* x, T* y, T s, T t) {
+      [&](T* x, T* y, T s, T t, bool from_zero) {
         A.update_ghosts(x);
-        A.chebyshev_step(w.bp, x, y, dinv_l, s, t);
+        A.chebyshev_step(w.bp, x, y, dinv_l, s, t, from_zero);
       },
       in);
 }
@@ -520,10 +520,23 @@ void Multigrid::apply(const real* r, real* z) const {
   } else {
     const InUse busy(*held<float>().cycle);
     Work<float>& w = work<float>()[0];
+    w.bp = w.b.data();
+    w.xp = w.x.data();
     convert<float>(n, r, w.b.data());
     vcycle_where_held<float>(0);
     convert<double>(n, w.x.data(), z);
   }
+  levels_[0].A.zero_ghosts(z);
+}
+
+void Multigrid::apply_in_float(const float* r, float* z) const {
+  if (!works_in_float()) throw std::logic_error("multigrid: apply_in_float on a V-cycle in double precision");
+  check_launch_space();
+  const InUse busy(*held<float>().cycle);
+  Work<float>& w = work<float>()[0];
+  w.bp = r;
+  w.xp = z;
+  vcycle_where_held<float>(0);
   levels_[0].A.zero_ghosts(z);
 }
 

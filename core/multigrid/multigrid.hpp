@@ -197,6 +197,10 @@ class Multigrid : public LinearOperator {
   // on level-0 vectors: this rank's slab (the whole grid on one rank)
   index size() const override { return levels_[0].A.size(); }
   void apply(const real* r, real* z) const override;
+  // a V-cycle in single precision takes r and gives z in float as well
+  // (operator.hpp): the V-cycle on the caller's arrays, without converting
+  bool works_in_float() const override { return opt_.precision == Precision::single_precision; }
+  void apply_in_float(const float* r, float* z) const override;
   // The V-cycle restricted to some level-0 entries, E^T M E: its
   // right-hand side is r[k] at entry at[k] and zero elsewhere, and z[k] its
   // result at entry at[k] (k < at.size(); `at` where the launches run, rows
@@ -235,8 +239,8 @@ class Multigrid : public LinearOperator {
   template <class T>
   struct Work {
     Field<T> x, b, r, fine_rows, coarse_rows;
-    T* xp = nullptr;        // iterate and right-hand side in use: the
-    const T* bp = nullptr;  // caller's arrays on a double level 0, host_x and host_b on
+    T* xp = nullptr;        // iterate and right-hand side in use: the caller's
+    const T* bp = nullptr;  // arrays on level 0 (a double one, or apply_in_float), host_x and host_b on
                             // the first host level of a device run (x and b: their device
                             // copies, which the finer level's transfers write and read)
     Field<T> host_x, host_b;

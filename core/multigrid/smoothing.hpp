@@ -2,13 +2,14 @@
 //
 // * chebyshev_smooth: `degree` steps of the Chebyshev polynomial in D^{-1}A
 //   targeting [lmax/range, lmax], in the three-term form x_{k+1} = x_k +
-//   s_k (x_k - x_{k-1}) + t_k Dinv (b - A x_k). `step(x, y, s, t)` is one
-//   step from x into y != x, y holding x_{k-1}, with the residual never
-//   stored (the operator's chebyshev_step: kernels/apply_out.hpp; s = 0
-//   for the first); the steps go back and forth between x and r, and the
-//   iterate leaves in x. It enters as 0 (zero_guess; the first step needs no
-//   residual, x = t Dinv b, and goes to whichever vector makes the rest end
-//   in x, the other set to x_0 = 0) or in `in` (x or r): in
+//   s_k (x_k - x_{k-1}) + t_k Dinv (b - A x_k). `step(x, y, s, t, from_zero)`
+//   is one step from x into y != x, y holding x_{k-1}, or not read where
+//   from_zero says x_{k-1} = 0 (or s = 0, the first), with the residual never
+//   stored (the operator's chebyshev_step: kernels/apply_out.hpp); the steps
+//   go back and forth between x and r, and the iterate leaves in x. It
+//   enters as 0 (zero_guess; the first step needs no residual, x = t Dinv b,
+//   and goes to whichever vector makes the rest end in x; the second is
+//   from_zero) or in `in` (x or r): in
 //   chebyshev_entry(degree, x, r) every step is a fused one; in the other
 //   vector the first step forms a residual in the free vector (`residual(x,
 //   y)`, y = b - A x), updates the iterate in place and leaves x_0 where
@@ -55,7 +56,7 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
   T* at = zero_guess ? chebyshev_entry(degree - 1, x, r) : in == r ? r : x;
   int k = 0;
   if (zero_guess) {  // from x = 0: no residual to form
-    cheb_first<T>(n, T(t), dinv, b, at, other(at));
+    cheb_first<T>(n, T(t), dinv, b, at);
     next();
     k = 1;
   } else if (at != chebyshev_entry(degree, x, r)) {  // the first step in place
@@ -65,7 +66,7 @@ void chebyshev_smooth(index n, real lmax, real range, int degree, bool zero_gues
     k = 1;
   }
   for (; k < degree; ++k) {
-    step(at, other(at), T(s), T(t));
+    step(at, other(at), T(s), T(t), zero_guess && k == 1);
     at = other(at);
     next();
   }

@@ -32,12 +32,19 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
                                 std::to_string(n));
   if (!(opt.rtol >= 0) || !(opt.atol >= 0) || opt.max_iterations < 0)
     throw std::invalid_argument("pcg: tolerances must be >= 0 and max_iterations >= 0");
+  // a single-precision preconditioner gets r in float, written by the
+  // update, and its z is read in float where it is used (operator.hpp)
+  const bool in_float = M && M->works_in_float();
   ws.r.resize(n);
-  ws.z.resize(n);
+  ws.z.resize(in_float ? 0 : n);
   ws.p.resize(n);
   ws.q.resize(n);
+  ws.r_low.resize(in_float ? n : 0);
+  ws.z_low.resize(in_float ? n : 0);
   if (side) ws.s.resize(side->side_size());
   real *r = ws.r.data(), *z = ws.z.data(), *p = ws.p.data(), *q = ws.q.data(), *sp = ws.s.data();
+  float* r_low = in_float ? ws.r_low.data() : nullptr;
+  float* z_low = in_float ? ws.z_low.data() : nullptr;
   SolveStats st;
   // local sums -> the sum over all ranks (identity on one rank)
   auto global = [&](real local) { return opt.reduction ? opt.reduction->sum(local) : local; };
@@ -49,22 +56,23 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     else
       A.apply(in, out);
   };
-  const real bb = global(dot(n, b, b));
-  st.rhs_norm = std::sqrt(bb);
+  // r = b - A x, with r's float copy for M and r.r in one sweep (from x =
+  // 0, r = b: r.r is b.b, with dot's bits)
+  real bb, rr;
   if (opt.zero_initial_guess) {
     fill<real>(n, 0, x);
-    copy(n, b, r);
     if (side && !opt.side_adds) fill<real>(side->side_size(), 0, side_x);
+    bb = rr = global(cg_start(n, b, nullptr, r, r_low));
   } else {
+    bb = global(dot(n, b, b));
     apply(x, q);
     if (side && opt.side_adds)
       axpy(side->side_size(), 1, sp, side_x);
     else if (side)
       copy(side->side_size(), sp, side_x);
-    triad(n, b, -1, q, r);  // r = b - A x in one sweep
+    rr = global(cg_start(n, b, q, r, r_low));
   }
-  // (from x = 0, r is a copy of b: the same sum, bit for bit, without a sweep)
-  real rr = opt.zero_initial_guess ? bb : global(dot(n, r, r));
+  st.rhs_norm = std::sqrt(bb);
   st.initial_residual = st.residual = std::sqrt(rr);
   const real target = std::max(opt.rtol * st.rhs_norm, opt.atol);
   if (!std::isfinite(rr)) {
@@ -75,14 +83,21 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
   if (opt.on_residual) opt.on_residual(st.residual);
   auto precondition = [&] {
     st.preconditioner_applications += 1;
-    if (M)
+    if (in_float)
+      M->apply_in_float(r_low, z_low);
+    else if (M)
       M->apply(r, z);
     else
       copy(n, r, z);
   };
   precondition();
-  std::swap(z, p);  // p = z without a copy: z is written afresh before it is read again
-  real rz = global(dot(n, r, p));
+  real rz;
+  if (in_float) {
+    rz = global(cg_first_direction(n, r, z_low, p));
+  } else {
+    std::swap(z, p);  // p = z without a copy: z is written afresh before it is read again
+    rz = global(dot(n, r, p));
+  }
   for (int it = 1; it <= opt.max_iterations; ++it) {
     if (!(rz > 0)) {
       st.reason = std::isfinite(rz) ? SolveReason::breakdown : SolveReason::non_finite;
@@ -106,7 +121,7 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     if (side) axpy(side->side_size(), alpha, sp, side_x);
     {
       ScopedTimer t(Kernel::vector, n * kCgUpdateCost);
-      rr = global(cg_update(n, alpha, p, q, x, r));
+      rr = global(in_float ? cg_update(n, alpha, p, q, x, r, r_low) : cg_update(n, alpha, p, q, x, r));
     }
     st.iterations = it;
     st.residual = std::sqrt(rr);
@@ -118,8 +133,11 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     if (opt.on_residual) opt.on_residual(st.residual);
     precondition();
     ScopedTimer t(Kernel::vector, n * (kDotCost + kXpayCost));
-    const real rz_new = global(dot(n, r, z));
-    xpay(n, z, rz_new / rz, p);
+    const real rz_new = global(in_float ? dot(n, r, z_low) : dot(n, r, z));
+    if (in_float)
+      xpay(n, z_low, rz_new / rz, p);
+    else
+      xpay(n, z, rz_new / rz, p);
     rz = rz_new;
   }
   st.reason = SolveReason::max_iterations;

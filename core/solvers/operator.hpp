@@ -9,6 +9,8 @@
 // else. A solver calls it on its own vector before each apply; operators
 // without ghosts do nothing.
 #pragma once
+#include <stdexcept>
+
 #include "kernels/types.hpp"
 
 namespace tresca {
@@ -19,6 +21,17 @@ class LinearOperator {
   virtual index size() const = 0;
   virtual void apply(const real* x, real* y) const = 0;
   virtual void update_ghosts(real* x) const { (void)x; }
+  // An operator that computes in single precision (the multigrid's float
+  // V-cycle) also takes and gives float vectors: apply() converts x in and
+  // y out in sweeps of their own, which a solver that keeps the float
+  // copies itself (pcg: r's written by its update, z's read where it is
+  // used) saves. apply_in_float(x, y) is apply() without the conversions:
+  // the same y, rounded to float.
+  virtual bool works_in_float() const { return false; }
+  virtual void apply_in_float(const float* x, float* y) const {
+    (void)x, (void)y;
+    throw std::logic_error("apply_in_float: this operator works in double precision");
+  }
 };
 
 // An operator y = A x whose evaluation also yields s = B x for a second linear
