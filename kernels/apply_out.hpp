@@ -45,8 +45,15 @@ struct ApplyOut {
   const T* b = nullptr;     // the residual's and the step's right-hand side
   const T* dinv = nullptr;  // the step's (read where the header says); set with s and t
   T s = 0, t = 0;
-  bool prev_zero = false;  // the step's iterate before x is zero: y not read
+  // the step's iterate before x is zero: y not read (0 or 1, a whole word:
+  // the struct has no padding, whose stale bytes the device guard would
+  // read as host addresses in a device body, kernels/launch.hpp)
+  index prev_zero = 0;
 };
+
+static_assert(sizeof(ApplyOut<float>) == 3 * sizeof(void*) + 2 * sizeof(float) + sizeof(index) &&
+                  sizeof(ApplyOut<double>) == 3 * sizeof(void*) + 2 * sizeof(double) + sizeof(index),
+              "ApplyOut without padding (prev_zero's comment)");
 
 template <class T>
 ApplyOut<T> operator_out(T* y) {
@@ -58,7 +65,7 @@ ApplyOut<T> residual_out(const T* b, T* y) {
 }
 template <class T>
 ApplyOut<T> chebyshev_out(const T* b, const T* dinv, T s, T t, T* y, bool prev_zero = false) {
-  return {y, b, dinv, s, t, prev_zero};
+  return {y, b, dinv, s, t, prev_zero ? 1 : 0};
 }
 
 // Everything that computes with an ApplyOut has internal linkage (an unnamed
@@ -83,7 +90,7 @@ inline void store_as(T* p, U v) {
 enum class OutKind { value, residual, step_from_zero, step };
 template <class T>
 constexpr OutKind kind(const ApplyOut<T>& o) {
-  return o.dinv ? (o.s != 0 && !o.prev_zero ? OutKind::step : OutKind::step_from_zero)
+  return o.dinv ? (o.s != 0 && o.prev_zero == 0 ? OutKind::step : OutKind::step_from_zero)
                 : o.b ? OutKind::residual
                       : OutKind::value;
 }

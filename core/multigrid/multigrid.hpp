@@ -46,7 +46,8 @@
 //
 // Precision: the V-cycle runs in double, or in single precision (float
 // stencils, transfers, smoother vectors; input and output converted at the
-// finest level; the coarsest grid is solved in double). Single precision
+// finest level, or taken and given in float by a caller that keeps float
+// copies, apply_in_float: CG, cg.hpp; the coarsest grid is solved in double). Single precision
 // halves the bytes and doubles the vector lanes of every V-cycle kernel. As
 // a preconditioner of a double-precision CG it only has to be a good
 // approximate inverse: its rounding (relative 1e-7) is far below what the
