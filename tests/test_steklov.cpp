@@ -99,4 +99,33 @@ TEST(SteklovPoincare, ResidualFromAWarmBodyOnlyCorrects) {
   EXPECT_LT(test::max_abs_diff(r2, r), 1e-9 * test::max_abs(r));
 }
 
+// S v and E v however the caller asks (the inner solve runs in the
+// extension itself where one is given, from a guess in place where the
+// guess is that array): without an extension, with one, with a guess apart
+// (left as it was) and with the guess in the extension: the same S v
+TEST(SteklovPoincare, ExtensionAskedForInPlaceOrApartGivesTheSameApply) {
+  const Problem P = make_problem(spec_for_dims(12, 6, 5));
+  SteklovPoincare S(P);
+  auto v = test::random_vector(S.size(), 9);
+  for (auto& e : v) e *= 1e-3;
+  const index n = S.size(), nf = S.full_size();
+  std::vector<real> Sv0(n), Sv1(n), Sv2(n), Sv3(n), E1(nf, std::nan("")), E2(nf), E3(nf);
+  ASSERT_TRUE(S.apply(v.data(), Sv0.data(), 1e-12).ok());
+  ASSERT_TRUE(S.apply(v.data(), Sv1.data(), 1e-12, E1.data()).ok());
+  for (index i = 0; i < n; ++i) ASSERT_EQ(Sv0[i], Sv1[i]) << i;  // (the same solve, in another array)
+  // a guess near E v, apart from the extension and in it
+  auto guess = E1;
+  const auto noise = test::random_vector(nf, 10);
+  for (index i = 0; i < nf; ++i) guess[i] += 1e-7 * test::max_abs(E1) * noise[i];
+  const auto guess_was = guess;
+  ASSERT_TRUE(S.apply(v.data(), Sv2.data(), 1e-12, E2.data(), guess.data()).ok());
+  for (index i = 0; i < nf; ++i) ASSERT_EQ(guess[i], guess_was[i]) << i;
+  E3 = guess;
+  ASSERT_TRUE(S.apply(v.data(), Sv3.data(), 1e-12, E3.data(), E3.data()).ok());
+  for (index i = 0; i < n; ++i) ASSERT_EQ(Sv2[i], Sv3[i]) << i;
+  for (index i = 0; i < nf; ++i) ASSERT_EQ(E2[i], E3[i]) << i;
+  EXPECT_LT(test::max_abs_diff(Sv2, Sv0), 1e-9 * test::max_abs(Sv0));
+  EXPECT_LT(test::max_abs_diff(E2, E1), 1e-9 * test::max_abs(E1));
+}
+
 }  // namespace tresca

@@ -48,7 +48,6 @@ SteklovPoincare::SteklovPoincare(const Problem& P, const MGOptions& mg, const Co
   K_.zero_ghosts(interior_load_.data());
   w_.assign(n, 0);
   t_.assign(n, 0);
-  z_.assign(n, 0);
 }
 
 SteklovPoincare::~SteklovPoincare() = default;
@@ -107,7 +106,7 @@ SolveStats SteklovPoincare::solve_interior(const real* rhs, real* z, real rtol, 
   o.rtol = rtol;
   const ElasticityOperator& Kii = mg_->op(0);
   if (guess) {
-    copy(full_size(), guess, z);
+    if (guess != z) copy(full_size(), guess, z);
     zero_constrained(box(), Kii.faces(), z);  // the guess of an extension carries v on plane 0
     o.zero_initial_guess = false;
   }
@@ -153,14 +152,18 @@ SolveStats SteklovPoincare::extend(const real* v, real* li, real* out, real rtol
   scale(plane1, -1, t_.data());
   // right-hand side -K_ic v, or l_i - K_ic v in li itself
   if (li) axpy(plane1, 1, t_.data(), li);
-  const SolveStats st = solve_interior(li ? li : t_.data(), z_.data(), rtol, guess);
+  // z solved where u = w + z is wanted: in `extension` itself (from the
+  // guess in place where that is the same array), or in z_, made when a
+  // call first has no extension (the Newton steps' CG always gives one)
+  if (!extension && index(z_.size()) != full_size()) z_.resize(full_size());
+  real* z = extension ? extension : z_.data();
+  const SolveStats st = solve_interior(li ? li : t_.data(), z, rtol, guess);
   // u = w + z: z vanishes on the constrained plane 0, where w lives
-  set_plane(z_.data(), 0, w_.data());
+  set_plane(z, 0, w_.data());
   // (K u)_c on plane 0, then restore t_'s invariant
-  apply_planes(z_.data(), t_.data(), 0, 1);
+  apply_planes(z, t_.data(), 0, 1);
   gather(t_.data(), out);
   set_plane(t_.data(), 0, nullptr);
-  if (extension) copy(3 * N, z_.data(), extension);
   return st;
 }
 

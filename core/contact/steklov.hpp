@@ -133,7 +133,7 @@ class SteklovPoincare {
   mutable CGWorkspace ws_;  // scratch
   Field<index> rows_;                         // contact_rows()
   Field<real> interior_load_, contact_load_;  // l_i (K_ii's rows: 3D) and l_c (3p), this rank's
-  mutable Field<real> w_, t_, z_, load_;     // load_: residual()'s right-hand side
+  mutable Field<real> w_, t_, z_, load_;     // z_: extend()'s without an extension; load_: residual()'s right-hand side
 };
 
 }  // namespace tresca
