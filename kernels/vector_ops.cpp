@@ -79,7 +79,8 @@ real block_dot(index i0, index i1, const TX* x, const T* w, const T* y) {
 template <class TX, class TY>
 real dot(index n, const TX* x, const TY* y) {
   const char* name = sizeof(TX) == sizeof(TY) ? precision_name<TY>("dot", "dot (float)") : "dot (double, float)";
-  return sum_over_blocks(name, n, kDotBlock, Cost{double(sizeof(TX) + sizeof(TY)), kDotCost.flops},
+  const Cost cost = sizeof(TX) == sizeof(TY) ? in_precision<TY>(kDotCost) : kDotFloatYCost;
+  return sum_over_blocks(name, n, kDotBlock, cost,
                          [x, y](index i0, index i1) { return block_dot<false>(i0, i1, x, y, y); },
                          [x, y](index i) { return real(x[i]) * real(y[i]); });
 }
@@ -100,7 +101,7 @@ void xpay(index n, const real* x, real a, real* y) {
   for_each_entry("xpay", n, kXpayCost, [=](index i) { y[i] = x[i] + a * y[i]; });
 }
 void xpay(index n, const float* x, real a, real* y) {
-  for_each_entry("xpay (float x)", n, Cost{kXpayCost.bytes - 4, kXpayCost.flops},
+  for_each_entry("xpay (float x)", n, kXpayFloatXCost,
                  [=](index i) { y[i] = real(x[i]) + a * y[i]; });
 }
 void copy(index n, const real* x, real* y) {
@@ -183,7 +184,7 @@ real cg_update(index n, real a, const real* p, const real* q, real* x, real* r) 
   return cg_update_in<false>("cg update", kCgUpdateCost, n, a, p, q, x, r, nullptr);
 }
 real cg_update(index n, real a, const real* p, const real* q, real* x, real* r, float* r_low) {
-  return cg_update_in<true>("cg update (and r in float)", kCgUpdateCost + Cost{4, 0}, n, a, p, q, x, r, r_low);
+  return cg_update_in<true>("cg update (and r in float)", kCgUpdateFloatRCost, n, a, p, q, x, r, r_low);
 }
 
 namespace {

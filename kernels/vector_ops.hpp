@@ -26,6 +26,8 @@ constexpr index kDotBlock = 4096;
 constexpr Cost kDotCost{16, 2}, kAxpyCost{24, 2}, kXpayCost{24, 2}, kCgUpdateCost{48, 6}, kChebUpdateCost{40, 6},
     kChebFirstCost{24, 2}, kChebFirstOnGuessCost{40, 3}, kCopyCost{16, 0}, kFillCost{8, 0}, kScaleCost{16, 1},
     kHadamardCost{24, 1}, kTriadCost{24, 2}, kJacobiCgUpdateCost{32, 5}, kJacobiXpayCost{32, 3};
+// the CG's forms with a float vector (the table's note)
+constexpr Cost kDotFloatYCost{12, 2}, kXpayFloatXCost{20, 2}, kCgUpdateFloatRCost{52, 6};
 
 template <class TX, class TY>
 real dot(index n, const TX* x, const TY* y);  // (TX, TY) = (double, double), (float, float), (double, float)

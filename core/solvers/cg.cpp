@@ -120,7 +120,7 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     const real alpha = rz / pq;
     if (side) axpy(side->side_size(), alpha, sp, side_x);
     {
-      ScopedTimer t(Kernel::vector, n * kCgUpdateCost);
+      ScopedTimer t(Kernel::vector, n * (in_float ? kCgUpdateFloatRCost : kCgUpdateCost));
       rr = global(in_float ? cg_update(n, alpha, p, q, x, r, r_low) : cg_update(n, alpha, p, q, x, r));
     }
     st.iterations = it;
@@ -132,7 +132,7 @@ SolveStats pcg_impl(const LinearOperator& A, const LinearOperatorWithSide* side,
     if (st.residual <= target) return st;
     if (opt.on_residual) opt.on_residual(st.residual);
     precondition();
-    ScopedTimer t(Kernel::vector, n * (kDotCost + kXpayCost));
+    ScopedTimer t(Kernel::vector, n * (in_float ? kDotFloatYCost + kXpayFloatXCost : kDotCost + kXpayCost));
     const real rz_new = global(in_float ? dot(n, r, z_low) : dot(n, r, z));
     if (in_float)
       xpay(n, z_low, rz_new / rz, p);
