@@ -456,8 +456,9 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
   if (N.history.empty() && N.reason == NewtonReason::inner_failure)
     std::printf("note: the inner solver (multigrid CG on the body's interior) did not converge for the condensed\n"
                 "      load b~, so Newton did not start: the lines below are of u = 0, with |b~| unknown\n");
-  std::printf("true residual (fresh S u - b~): %.3e absolute, %.3e relative to |b| = %.3e\n", F.true_residual,
-              F.true_residual_relative, F.btilde_norm);
+  std::printf("true residual (fresh S u - b~): %.3e absolute, %.3e relative to |b~| %s %.3e%s\n", F.true_residual,
+              F.true_residual_relative, R.btilde_estimated ? "~" : "=", F.btilde_norm,
+              R.btilde_estimated ? " (from the coarser mesh)" : "");
   if (N.reason == NewtonReason::stagnation && !N.history.empty() && N.history.back() <= 1e-9 * N.history.front())
     std::printf("note: |v| stagnated at %.1e of its initial value, the accuracy the inner solves attain: eps = %.1e\n"
                 "      is out of reach for this problem's magnitudes (--eps %.0e would be met)\n",

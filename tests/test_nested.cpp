@@ -104,6 +104,11 @@ void nested_equals_cold(real phi, real gap) {
   EXPECT_LT(test::max_abs_diff(nested.newton.lambda, cold.newton.lambda), 1e-6 * test::max_abs(cold.newton.lambda));
   EXPECT_TRUE(nested.report.status == cold.report.status);
   EXPECT_LT(nested.report.true_residual_relative, 1e-10);
+  // the fine mesh's |b̃| from the coarser mesh's K_ii^{-1} l_i, no solve: to a
+  // few per cent of the cold start's (Newton's first residual, -b̃)
+  EXPECT_TRUE(nested.btilde_estimated);
+  EXPECT_FALSE(cold.btilde_estimated);
+  EXPECT_NEAR(nested.report.btilde_norm, cold.report.btilde_norm, 0.05 * cold.report.btilde_norm);
   EXPECT_GT(nested.fine_matvecs_total, nested.newton.fine_matvecs);  // the coarse work is counted
 }
 

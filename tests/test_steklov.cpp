@@ -80,6 +80,35 @@ TEST(SteklovPoincare, RecoveryAndResidualMatchDense) {
   EXPECT_LT(rerr, 1e-9 * rd.cwiseAbs().maxCoeff());
 }
 
+// b̃ without a solve, l_c − K_ci z, from a given z: K_ii^{-1} l_i itself
+// gives the condensed load (the dense one), whatever z holds on the
+// constrained planes or beyond the plane next to the contact face
+TEST(SteklovPoincare, CondensedLoadFromTheInteriorSolutionIsTheCondensedLoad) {
+  const Problem P = make_problem(spec_for_dims(5, 3, 4));
+  const SteklovPoincare S(P);
+  const DenseSchur d = dense_schur(P);
+  Field<real> b, li;
+  ASSERT_TRUE(S.condensed_load(1e-13, b, &li).ok());
+  const real scale = d.b.cwiseAbs().maxCoeff();
+  Field<real> from;
+  std::vector<real> z = li.to_vector();
+  S.condensed_load_from(z.data(), from);
+  ASSERT_EQ(index(from.size()), S.size());
+  for (index i = 0; i < S.size(); ++i) {
+    EXPECT_NEAR(from[i], d.b[i], 1e-9 * scale) << i;
+    EXPECT_NEAR(from[i], b[i], 1e-13 * scale) << i;
+  }
+  // garbage on the contact face (zeroed) and on the planes iz >= 2 (not read)
+  const GridDims& g = P.grid;
+  const index N = g.nodes(), plane = g.nx() * g.ny();
+  for (int a = 0; a < 3; ++a)
+    for (index k = 0; k < N; ++k)
+      if (k < plane || k >= 2 * plane) z[a * N + k] = 1e3 * real(k % 7 + 1);
+  Field<real> again;
+  S.condensed_load_from(z.data(), again);
+  for (index i = 0; i < S.size(); ++i) EXPECT_EQ(again[i], from[i]) << i;
+}
+
 TEST(SteklovPoincare, ResidualFromAWarmBodyOnlyCorrects) {
   // a body off by 1e-6 relative: the same residual in fewer iterations
   const Problem P = make_problem(spec_for_dims(16, 8, 8));

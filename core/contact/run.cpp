@@ -202,14 +202,21 @@ void choose_initial_iterate(const SteklovPoincare& S, const RunOptions& opt, con
 // |b̃|, the scale of Newton's absolute accuracies and of the report: from
 // x0 = 0 Newton's first residual is -b̃ (nothing to do here); an initial
 // iterate takes a loose solve of its own (a coarser mesh of nested
-// iteration always, to hand up its K_ii^{-1} l_i)
+// iteration always, to hand up its K_ii^{-1} l_i). The finest mesh of nested
+// iteration takes it from the coarser mesh's K_ii^{-1} l_i, without a solve:
+// a scale to about 1 %, for three inner iterations fewer (perf/RESULTS.md §0zp).
 SolveStats scale_of_load(const SteklovPoincare& S, const RunOptions& opt, NewtonOptions& newton, Start& start,
                          RunResult& R) {
   SolveStats cond;
   if (newton.u0 || opt.keep_interior_load) {
     Field<real> btilde;
-    cond = S.condensed_load(opt.scale_rtol, btilde, opt.keep_interior_load ? &R.interior_load : nullptr,
-                            start.load_guess.empty() ? nullptr : start.load_guess.data());
+    if (!opt.keep_interior_load && !start.load_guess.empty()) {
+      S.condensed_load_from(start.load_guess.data(), btilde);
+      R.btilde_estimated = true;
+    } else {
+      cond = S.condensed_load(opt.scale_rtol, btilde, opt.keep_interior_load ? &R.interior_load : nullptr,
+                              start.load_guess.empty() ? nullptr : start.load_guess.data());
+    }
     newton.force_scale = force_scale_of(std::sqrt(S.sum(dot(index(btilde.size()), btilde.data(), btilde.data()))));
   }
   start.load_guess = {};
@@ -299,7 +306,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   const bool loose_load = newton.u0 || opt.keep_interior_load;
   const SolveStats cond = scale_of_load(S, opt, newton, start, R);
   const double t2 = wall_time();
-  if (opt.phase_done && loose_load) opt.phase_done("|b~| (loose condensed load)", t2 - t1);
+  if (opt.phase_done && loose_load)
+    opt.phase_done(R.btilde_estimated ? "|b~| (from the coarser mesh, no solve)" : "|b~| (loose condensed load)", t2 - t1);
 
   if (cond.ok()) {
     solve_contact(S, opt, law, newton, R);

@@ -112,6 +112,10 @@ struct RunResult {
   Field<real> u_full;               // 3N SoA (empty if not recovered); several ranks: slab's local vector
   Slab slab;                        // the rank's rows of u_full (one rank: the whole grid)
   Field<real> interior_load;        // K_ii^{-1} l_i to scale_rtol, 3N SoA (keep_interior_load only)
+  // |b̃| (newton.force_scale, report.btilde_norm) from the coarser mesh's
+  // K_ii^{-1} l_i without a solve (the finest mesh of nested iteration): to
+  // about 1 %, not to scale_rtol
+  bool btilde_estimated = false;
   long long inner_iterations = 0;  // over the whole run, including condensation and the final check
   // work in fine-grid matvec equivalents (the Newton phase alone is
   // newton.fine_matvecs): the whole run, |b̃|, Newton and the final tight

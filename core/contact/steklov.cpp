@@ -160,11 +160,15 @@ SolveStats SteklovPoincare::extend(const real* v, real* li, real* out, real rtol
   const SolveStats st = solve_interior(li ? li : t_.data(), z, rtol, guess);
   // u = w + z: z vanishes on the constrained plane 0, where w lives
   set_plane(z, 0, w_.data());
-  // (K u)_c on plane 0, then restore t_'s invariant
-  apply_planes(z, t_.data(), 0, 1);
+  contact_rows_of_K(z, out);
+  return st;
+}
+
+void SteklovPoincare::contact_rows_of_K(real* x, real* out) const {
+  // (K x)_c on plane 0, then restore t_'s invariant
+  apply_planes(x, t_.data(), 0, 1);
   gather(t_.data(), out);
   set_plane(t_.data(), 0, nullptr);
-  return st;
 }
 
 double SteklovPoincare::apply_work(long long inner_iterations) const {
@@ -180,6 +184,16 @@ SolveStats SteklovPoincare::condensed_load(real rtol, Field<real>& b, Field<real
   const SolveStats st = residual(zero.data(), b.data(), rtol, interior ? interior->data() : nullptr, guess);
   scale(3 * p_, -1, b.data());
   return st;
+}
+
+void SteklovPoincare::condensed_load_from(real* interior, Field<real>& b) const {
+  if (index(b.size()) != 3 * p_) b = Field<real>(3 * p_);
+  // z on the contact face is u = 0 (a constrained plane of K_ii)
+  zero_constrained(box(), mg_->op(0).faces(), interior);
+  // b̃ = −((K z)_c − l_c), as condensed_load's −residual(0)
+  contact_rows_of_K(interior, b.data());
+  axpy(3 * p_, -1, contact_load_.data(), b.data());
+  scale(3 * p_, -1, b.data());
 }
 
 }  // namespace tresca

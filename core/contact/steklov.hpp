@@ -93,6 +93,12 @@ class SteklovPoincare {
   // guess (3N): initial guess of K_ii^{-1} l_i.
   SolveStats condensed_load(real rtol, Field<real>& b, Field<real>* interior = nullptr,
                             const real* guess = nullptr) const;
+  // b ≈ b̃ without a solve: l_c − K_ci z for a given z ≈ K_ii^{-1} l_i (3N,
+  // e.g. a coarser mesh's, prolongated; its constrained values are zeroed in
+  // place). Plane-sized work: only z's plane next to the contact face
+  // enters, so b's error is z's there (about 1 % from a coarser mesh's solve
+  // at levels 9 to 12: perf/RESULTS.md §0zp).
+  void condensed_load_from(real* interior, Field<real>& b) const;
 
   // the K_ii multigrid; its hierarchy() is shared with the Newton step's preconditioner
   const Multigrid& interior_multigrid() const { return *mg_; }
@@ -116,6 +122,8 @@ class SteklovPoincare {
   // K_ii z = −K_ic v, or with li (the interior load, 3D, overwritten)
   // K_ii z = l_i − K_ic v; x into `extension` if given
   SolveStats extend(const real* v, real* li, real* out, real rtol, real* extension, const real* guess) const;
+  // out = (K x)_c, the contact rows of K x (x 3D, its ghost rows updated)
+  void contact_rows_of_K(real* x, real* out) const;
   // plane iz of all 3 components of v := src's (or 0 if src is null)
   void set_plane(real* v, index iz, const real* src) const;
   // y = K x on planes [z_begin, z_end), x's ghost rows updated first

@@ -99,6 +99,8 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["final_residual"] = N.history.empty() ? Json(nullptr) : Json(N.history.back());
   j["true_residual"] = F.true_residual;
   j["true_residual_relative"] = F.true_residual_relative;
+  j["btilde_norm"] = F.btilde_norm;  // |b̃| [N], the scale of the relative figures
+  j["btilde_estimated"] = R.btilde_estimated;  // from the coarser mesh's interior solve (about 1 %)
   j["true_residual_within_eps"] = F.true_residual <= eps;
   j["true_residual_resolution"] = F.resolution;  // r is known to about this [N]
   // the kernel profile of the run (core/util/profile.hpp; shares of the total add up to 1 with "other")
