@@ -62,6 +62,22 @@ real block_sum(index i0, index i1, const VTerm& vterm, const STerm& sterm) {
   return s;
 }
 
+// a block_sum tail's term as sum_over_blocks' entry (the device's form):
+// the product of its factors
+template <class STerm>
+auto product_of(const STerm& sterm) {
+  return [=](index i) {
+    const Factors f = sterm(i);
+    return f.a * f.b;
+  };
+}
+
+// the factors of entry i's product in x.y: x_i and y_i, or with weights w, w_i y_i
+template <bool Weighted, class TX, class T>
+auto dot_term(const TX* x, const T* w, const T* y) {
+  return [=](index i) { return Factors{real(x[i]), Weighted ? real(w[i]) * real(y[i]) : real(y[i])}; };
+}
+
 // The sum over [i0, i1) of x_i y_i, or with weights w of x_i (w_i y_i)
 template <bool Weighted, class TX, class T>
 real block_dot(index i0, index i1, const TX* x, const T* w, const T* y) {
@@ -73,7 +89,7 @@ real block_dot(index i0, index i1, const TX* x, const T* w, const T* y) {
         else
           return VFactors{load_real(x + i), load_real(y + i)};
       },
-      [=](index i) { return Factors{real(x[i]), Weighted ? real(w[i]) * real(y[i]) : real(y[i])}; });
+      dot_term<Weighted>(x, w, y));
 }
 
 template <class TX, class TY>
@@ -82,7 +98,7 @@ real dot(index n, const TX* x, const TY* y) {
   const Cost cost = sizeof(TX) == sizeof(TY) ? in_precision<TY>(kDotCost) : kDotFloatYCost;
   return sum_over_blocks(name, n, kDotBlock, cost,
                          [x, y](index i0, index i1) { return block_dot<false>(i0, i1, x, y, y); },
-                         [x, y](index i) { return real(x[i]) * real(y[i]); });
+                         product_of(dot_term<false>(x, y, y)));
 }
 
 template <class T>
@@ -152,6 +168,13 @@ namespace {
 template <bool kLow>
 real cg_update_in(const char* kernel, Cost cost, index n, real a, const real* p, const real* q, real* x, real* r,
                   float* r_low) {
+  // one entry's update and its term of r.r (the block's tail, the device's form)
+  const auto entry = [=](index i) {
+    x[i] += a * p[i];
+    r[i] -= a * q[i];
+    if constexpr (kLow) r_low[i] = float(r[i]);
+    return r[i] * r[i];
+  };
   // fused in blocks so that r is still in cache (registers) when r.r is formed
   return sum_over_blocks(kernel, n, kDotBlock, cost, [=](index i0, index i1) {
     V s0{};
@@ -164,19 +187,9 @@ real cg_update_in(const char* kernel, Cost cost, index n, real a, const real* p,
       s0 += ri * ri;
     }
     real s = hsum(s0);
-    for (; i < i1; ++i) {
-      x[i] += a * p[i];
-      r[i] -= a * q[i];
-      if constexpr (kLow) r_low[i] = float(r[i]);
-      s += r[i] * r[i];
-    }
+    for (; i < i1; ++i) s += entry(i);
     return s;
-  }, [=](index i) {
-    x[i] += a * p[i];
-    r[i] -= a * q[i];
-    if constexpr (kLow) r_low[i] = float(r[i]);
-    return r[i] * r[i];
-  });
+  }, entry);
 }
 }  // namespace
 
@@ -193,23 +206,20 @@ real cg_start_in(index n, const real* b, const real* q, real* r, float* r_low) {
   const char* name = kQ ? (kLow ? "cg start (r = b - q, and in float)" : "cg start (r = b - q)")
                         : (kLow ? "cg start (r = b, and in float)" : "cg start (r = b)");
   const Cost cost{(kQ ? 24.0 : 16.0) + (kLow ? 4.0 : 0.0), kQ ? 3.0 : 2.0};
+  const auto term = [=](index i) {  // one entry: its stores and the factors of its product
+    const real ri = kQ ? b[i] - q[i] : b[i];
+    r[i] = ri;
+    if constexpr (kLow) r_low[i] = float(ri);
+    return Factors{ri, ri};
+  };
   return sum_over_blocks(name, n, kDotBlock, cost, [=](index i0, index i1) {
     return block_sum(i0, i1, [=](index i) {
       const V ri = kQ ? load(b + i) - load(q + i) : load(b + i);
       store(r + i, ri);
       if constexpr (kLow) store_float(r_low + i, ri);
       return VFactors{ri, ri};
-    }, [=](index i) {
-      const real ri = kQ ? b[i] - q[i] : b[i];
-      r[i] = ri;
-      if constexpr (kLow) r_low[i] = float(ri);
-      return Factors{ri, ri};
-    });
-  }, [=](index i) {
-    r[i] = kQ ? b[i] - q[i] : b[i];
-    if constexpr (kLow) r_low[i] = float(r[i]);
-    return r[i] * r[i];
-  });
+    }, term);
+  }, product_of(term));
 }
 }  // namespace
 
@@ -219,20 +229,18 @@ real cg_start(index n, const real* b, const real* q, real* r, float* r_low) {
 }
 
 real cg_first_direction(index n, const real* r, const float* z, real* p) {
+  const auto term = [=](index i) {
+    const real pi = real(z[i]);
+    p[i] = pi;
+    return Factors{r[i], pi};
+  };
   return sum_over_blocks("cg first direction (p = z, float z)", n, kDotBlock, Cost{20, 2}, [=](index i0, index i1) {
     return block_sum(i0, i1, [=](index i) {
       const V pi = load_real(z + i);
       store(p + i, pi);
       return VFactors{load(r + i), pi};
-    }, [=](index i) {
-      const real pi = real(z[i]);
-      p[i] = pi;
-      return Factors{r[i], pi};
-    });
-  }, [=](index i) {
-    p[i] = real(z[i]);
-    return r[i] * p[i];
-  });
+    }, term);
+  }, product_of(term));
 }
 
 real cg_update_ref(index n, real a, const real* p, const real* q, real* x, real* r) {
