@@ -753,12 +753,14 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
 // tolerance by the smaller factor they missed their targets by. (One miss
 // alone may be the step's own: a cold start's free fall over a gap leaves
 // 0.2 r_F with ν = 0.45, and the next step meets its target.) A step whose
-// outer CG stopped at its iteration limit and missed tightens at once, by
-// its own factor: CG lost its way on S products too inexact to converge,
-// and a second such step in a row would end Newton (outer_failure) before
-// a second miss could tighten (a plate 2 x 1 x 0.0125 m of 32x16x4
-// elements did; RESULTS.md §0zl). The steps of ordinary runs never miss
-// twice in a row, never stop at the limit, and never tighten.
+// outer CG stopped at its iteration limit short of its target tightens at
+// once, by the factor it fell short by, even where it removed 90 % of r_F:
+// CG lost its way on S products too inexact to converge, and a second such
+// step in a row would end Newton (outer_failure) before a second miss
+// could tighten (a plate 2 x 1 x 0.0125 m of 32x16x4 elements did,
+// RESULTS.md §0zl; plates 2 x 1 x 0.0098-0.0101 m of 64x32x4 elements
+// after steps that removed 99 % of r_F, §0zp). The steps of ordinary runs
+// never miss twice in a row, never stop at the limit, and never tighten.
 void NewtonSolve::check_step(const real* Sdu, bool hit_limit) {
   const ReducedSystem::View V = L.view();
   const real *dU = du.data(), *Sk = L.known_product.data(), *rhs = L.rhs.data();
@@ -773,7 +775,9 @@ void NewtonSolve::check_step(const real* Sdu, bool hit_limit) {
   // (a factor > 1 where the step left more than a tenth of r_F, else 0)
   const real factor =
       missed > std::max(real(0.1) * step_rhs, step_target) && step_target > 0 ? missed / step_target : 0;
-  const real by = last_missed > 0 ? std::min(factor, last_missed) : hit_limit ? factor : 0;
+  // (a step stopped at the limit: the factor by which it fell short of its target)
+  const real short_by = hit_limit && missed > step_target && step_target > 0 ? missed / step_target : 0;
+  const real by = std::max(last_missed > 0 ? std::min(factor, last_missed) : real(0), short_by);
   if (by > 0) {
     const real tighter = std::min(work.tightening * by, real(1e8));
     // r's increments so far were that much less accurate than counted: its
