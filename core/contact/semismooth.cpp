@@ -337,10 +337,10 @@ real contact_stiffness_bound(const Problem& P) {
   return 4 * row;
 }
 
-bool stagnated(const std::vector<real>& h, int w) {
-  const int k = int(h.size());
+bool stagnated(const std::vector<real>& h, int w, int from) {
+  const int k = int(h.size()) - from;
   if (w <= 0 || k <= w) return false;
-  const real before = *std::min_element(h.begin(), h.end() - w);
+  const real before = *std::min_element(h.begin() + from, h.end() - w);
   const real last = *std::min_element(h.end() - w, h.end());
   return last > 0.5 * before;
 }
@@ -646,7 +646,15 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
   for_each_entry("newton states kept", p, Cost{2, 0}, [=](index i) { before[i] = now[i]; });
   if (k >= opt.max_iterations) return NewtonReason::iteration_limit;
   const bool progress = R.last_state_changes > 0 && R.merit[k] < R.merit[k - 1];
-  if (!progress && stagnated(R.merit, opt.stagnation_window)) return NewtonReason::stagnation;
+  if (!progress && stagnated(R.merit, opt.stagnation_window, std::max(R.monotone_from, 0))) {
+    // the non-monotone search let Newton wander (NewtonOptions::line_search):
+    // from here on each step must lower |w|, and stagnation is judged anew;
+    // not at the floor of what r resolves, where no search makes progress
+    const bool at_floor = *std::min_element(R.merit.begin(), R.merit.end()) <= resolved();
+    if (!opt.line_search || opt.line_search_memory == 0 || R.monotone_from >= 0 || at_floor)
+      return NewtonReason::stagnation;
+    R.monotone_from = k;
+  }
   return std::nullopt;
 }
 
@@ -705,7 +713,8 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
 
   real alpha = 1;
   if (opt.line_search) {
-    alpha = line_search(R.merit, opt.line_search_memory, opt.line_search_halvings, [&](real a) {
+    const int memory = R.monotone_from >= 0 ? 0 : opt.line_search_memory;
+    alpha = line_search(R.merit, memory, opt.line_search_halvings, [&](real a) {
       const real *u = x.u.data(), *r = x.r.data(), *lambda = x.lambda.data(), *dU = du.data(), *dl = dlambda.data();
       real *tu = trial.u.data(), *tr = trial.r.data(), *tl = trial.lambda.data();
       for_each_entry("line search trial", p, Cost{128, 14}, [=](index i) {

@@ -139,7 +139,15 @@ struct NewtonOptions {
   // would let the iterates wander) while the last step did not both change
   // some node's state and lower the merit (a front of separation that
   // advances a node or two a step is slow progress, not stagnation; the
-  // iteration limit bounds it). Off: full steps, and only the second test.
+  // iteration limit bounds it). The first time the window test holds, the
+  // search turns monotone instead (memory 0: each step must lower |w|) and
+  // the window starts again from there; stagnation is declared only if it
+  // holds again (NewtonResult::monotone_from). A semismooth Newton that
+  // cycles between two active sets, each step's |w| inside the window's
+  // maximum, is pulled out of the cycle: a 6x17x6 block on a cylinder cycled
+  // between 17 and 18 nodes in contact and now converges (RESULTS.md §0zq).
+  // Runs that converge without it never reach the test and are unchanged.
+  // Off: full steps, and only the second test.
   bool line_search = true;
   bool kink_contact = true;  // contact_maps.hpp: ContactLaw::kink_contact
   int line_search_memory = 5;
@@ -211,6 +219,7 @@ struct NewtonResult {
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
   int outer_limit_hits = 0;      // Newton steps whose outer CG stopped at its iteration limit
   int watchdog_steps = 0;        // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
+  int monotone_from = -1;        // the iteration from which the line search was monotone (-1: never; line_search)
   index last_state_changes = 0;  // nodes whose contact or stick state the last step changed (all ranks)
   // the factor (>= 1) by which the steps' inner tolerances were tightened
   // where two steps in a row, checked with a fresh S Δu, missed their accuracy
@@ -244,8 +253,9 @@ std::vector<real> step_scale(const SteklovPoincare& S);
 // eigenvalue on meshes one element thick.)
 real contact_stiffness_bound(const Problem& P);
 
-// The window test above on the merit history h (window w)
-bool stagnated(const std::vector<real>& h, int w);
+// The window test above on the merit history h (window w), on the entries
+// from `from` on (those since the line search turned monotone)
+bool stagnated(const std::vector<real>& h, int w, int from = 0);
 
 NewtonResult semismooth_newton(const SteklovPoincare& S, const ContactConditions& law, const NewtonOptions& opt);
 
