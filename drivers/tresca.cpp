@@ -492,6 +492,10 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
   if (N.watchdog_steps > 0)
     std::printf("note: %d Newton steps were taken whole where no step length decreased |w| (the line search's watchdog)\n",
                 N.watchdog_steps);
+  if (N.redone_steps > 0)
+    std::printf("note: %d Newton steps were solved again with tighter inner solves (the first solve stopped at the "
+                "outer CG's limit and no length of it lowered |w|)\n",
+                N.redone_steps);
   if (N.monotone_from >= 0)
     std::printf("note: from Newton step %d on each step had to lower |w| (a monotone line search): the "
                 "non-monotone search had made no progress\n",

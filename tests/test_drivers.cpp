@@ -301,6 +301,63 @@ TEST(TrescaDriver, ThinPlatesWhoseStepsAreInexactConvergeWithAVerifiedAnswer) {
   }
 }
 
+TEST(TrescaDriver, ProblemsOfARandomSweepThatStagnatedConvergeWithAVerifiedAnswer) {
+  // Drawn by perf/robustness_sweep.py (RESULTS.md §0zq), rounded to 4 digits.
+  // A 6x17x6 block on a cylinder: semismooth Newton cycled between 17 and 18
+  // nodes in contact, each step's |w| inside the non-monotone window, until
+  // the stagnation test ended it; the search now turns monotone there (the
+  // answer agrees to 1e-10 with the one plain CG's steps found). A plate of
+  // 7x10x5 elements 3.9 x 1.9 x 0.028 m and a Coulomb plate of nu = 0.47:
+  // the cold start's first step stopped its outer CG at the limit on S
+  // products too inexact to converge and no length of it lowered |w|
+  // (stagnation at step 0); it is now solved again with the tightened inner
+  // solves. And a 21x24x2 plate whose nested and fine solves both cycled.
+  const struct {
+    const char* name;
+    const char* json;
+    const char* note;
+  } cases[] = {
+      {"cycling_block",
+       R"({"mesh": {"dims": [6, 17, 6]}, "box": {"lengths": [1.263, 0.2882, 0.2028], "origin": [0, 0, 0]},
+           "material": {"E": 1.383e8, "nu": 0.0004139},
+           "loads": {"traction": {"z1": [-12430, 1087, -19530]}, "body_force": [0, 0, -626000]},
+           "friction": {"tresca": 40.08}, "obstacle": {"kind": "cylinder", "radius": 1.503, "y": 0.2082, "gap": 0}})",
+       "a monotone line search"},
+      {"first_step_redone",
+       R"({"mesh": {"dims": [7, 10, 5]}, "box": {"lengths": [3.861, 1.945, 0.02812], "origin": [0, 0, 0]},
+           "material": {"E": 1.15e8, "nu": 0.005871},
+           "loads": {"traction": {"z1": [-9537, 5978, -42500], "x1": [19350, -6802, 2087], "y0": [-11380, -10820, 7528]},
+                     "body_force": [0, 0, -1703000]},
+           "friction": {"tresca": 96800}, "obstacle": {"kind": "plane", "gap": 3.44e-07, "slope": [0.0004082, 0.0009561]}})",
+       "solved again with tighter inner solves"},
+      {"coulomb_first_step_redone",
+       R"({"mesh": {"dims": [23, 4, 5]}, "box": {"lengths": [0.8738, 0.3553, 0.04708], "origin": [0, 0, 0]},
+           "material": {"E": 8.535e6, "nu": 0.4715},
+           "loads": {"traction": {"z1": [-359.2, 321.1, 1416], "x1": [-7590, -216.7, -186.6], "y0": [-1317, 555.5, -88.35]}},
+           "friction": {"coulomb": 0.4385}, "obstacle": {"kind": "cylinder", "radius": 5.728, "y": 0.3464, "gap": 0}})",
+       "solved again with tighter inner solves"},
+      {"cycling_plate",
+       R"({"mesh": {"dims": [21, 24, 2]}, "box": {"lengths": [0.405, 0.5302, 0.03409], "origin": [0, 0, 0]},
+           "material": {"E": 1.739e8, "nu": 0.3508},
+           "loads": {"traction": {"z1": [-25650, -13120, -87230], "x1": [-37880, -20040, -27450]}},
+           "friction": {"tresca": 120.6}, "obstacle": {"kind": "plane", "gap": 0, "slope": [0.0007987, 0.0002689]}})",
+       nullptr}};
+  for (const auto& c : cases) {
+    const std::string file = ::testing::TempDir() + "/" + c.name + ".json";
+    {
+      std::ofstream f(file);
+      f << c.json;
+    }
+    const CmdResult r = run("tresca --quiet --problem " + file);
+    EXPECT_EQ(r.status, 0) << c.name << "\n" << r.out;
+    EXPECT_NE(r.out.find("converged after"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(": ok\n"), std::string::npos) << r.out;  // the KKT check
+    if (c.note) {
+      EXPECT_NE(r.out.find(c.note), std::string::npos) << c.name << "\n" << r.out;
+    }
+  }
+}
+
 TEST(TrescaDriver, WithoutLoadTheBodyStaysAtRest) {
   // b~ = 0: nested iteration (and the Coulomb fixed point) once stopped with
   // "an initial iterate u0 needs force_scale" (exit 2); u = 0, lambda = 0

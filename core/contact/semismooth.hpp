@@ -219,6 +219,7 @@ struct NewtonResult {
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
   int outer_limit_hits = 0;      // Newton steps whose outer CG stopped at its iteration limit
   int watchdog_steps = 0;        // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
+  int redone_steps = 0;          // steps solved again with tighter inner solves (their first stopped at the outer limit)
   int monotone_from = -1;        // the iteration from which the line search was monotone (-1: never; line_search)
   index last_state_changes = 0;  // nodes whose contact or stick state the last step changed (all ranks)
   // the factor (>= 1) by which the steps' inner tolerances were tightened

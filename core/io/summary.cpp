@@ -146,6 +146,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                  {"newton_inner_iterations", N.inner_iterations},
                  {"outer_limit_hits", N.outer_limit_hits},
                  {"watchdog_steps", N.watchdog_steps},
+                 {"redone_steps", N.redone_steps},
                  {"monotone_from", N.monotone_from},
                  {"last_state_changes", N.last_state_changes},
                  {"inner_tightening", N.inner_tightening},
