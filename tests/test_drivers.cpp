@@ -57,6 +57,23 @@ void expect_run(const std::string& args, int status, const std::string& says, co
   }
 }
 
+// `tresca --quiet --problem` on a problem file of these contents: a run
+// that converged with a verified answer (the KKT check ok) and says `note`
+void expect_verified_answer(const std::string& name, const std::string& json, const char* note = nullptr) {
+  const std::string file = ::testing::TempDir() + "/" + name + ".json";
+  {
+    std::ofstream f(file);
+    f << json;
+  }
+  const CmdResult r = run("tresca --quiet --problem " + file);
+  EXPECT_EQ(r.status, 0) << name << "\n" << r.out;
+  EXPECT_NE(r.out.find("converged after"), std::string::npos) << name << "\n" << r.out;
+  EXPECT_NE(r.out.find(": ok\n"), std::string::npos) << name << "\n" << r.out;  // the KKT check
+  if (note) {
+    EXPECT_NE(r.out.find(note), std::string::npos) << name << "\n" << r.out;
+  }
+}
+
 void expect_error(const std::string& args, const std::string& names) {
   const CmdResult r = run(args);
   EXPECT_EQ(r.status, 2) << args << "\n" << r.out;
@@ -287,18 +304,8 @@ TEST(TrescaDriver, ThinPlatesWhoseStepsAreInexactConvergeWithAVerifiedAnswer) {
                 {"thin_plate_64", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.01]}})"},
                 {"thin_plate_64_0099", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.0099]}})"},
                 {"thin_plate_64_0101", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.0101]}})"}};
-  for (const auto& plate : plates) {
-    const std::string file = ::testing::TempDir() + "/" + plate.name + ".json";
-    {
-      std::ofstream f(file);
-      f << plate.json;
-    }
-    const CmdResult r = run("tresca --quiet --problem " + file);
-    EXPECT_EQ(r.status, 0) << plate.name << "\n" << r.out;
-    EXPECT_NE(r.out.find("converged after"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find(": ok\n"), std::string::npos) << r.out;  // the KKT check
-    EXPECT_NE(r.out.find("note: the Newton steps' inner solves were tightened"), std::string::npos) << r.out;
-  }
+  for (const auto& plate : plates)
+    expect_verified_answer(plate.name, plate.json, "note: the Newton steps' inner solves were tightened");
 }
 
 TEST(TrescaDriver, ProblemsOfARandomSweepThatStagnatedConvergeWithAVerifiedAnswer) {
@@ -342,20 +349,7 @@ TEST(TrescaDriver, ProblemsOfARandomSweepThatStagnatedConvergeWithAVerifiedAnswe
            "loads": {"traction": {"z1": [-25650, -13120, -87230], "x1": [-37880, -20040, -27450]}},
            "friction": {"tresca": 120.6}, "obstacle": {"kind": "plane", "gap": 0, "slope": [0.0007987, 0.0002689]}})",
        nullptr}};
-  for (const auto& c : cases) {
-    const std::string file = ::testing::TempDir() + "/" + c.name + ".json";
-    {
-      std::ofstream f(file);
-      f << c.json;
-    }
-    const CmdResult r = run("tresca --quiet --problem " + file);
-    EXPECT_EQ(r.status, 0) << c.name << "\n" << r.out;
-    EXPECT_NE(r.out.find("converged after"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find(": ok\n"), std::string::npos) << r.out;  // the KKT check
-    if (c.note) {
-      EXPECT_NE(r.out.find(c.note), std::string::npos) << c.name << "\n" << r.out;
-    }
-  }
+  for (const auto& c : cases) expect_verified_answer(c.name, c.json, c.note);
 }
 
 TEST(TrescaDriver, WithoutLoadTheBodyStaysAtRest) {
