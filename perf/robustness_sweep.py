@@ -72,20 +72,21 @@ def draw(rng):
 
 
 def solve(binary, problem, out, timeout):
-    """(exit status, reason, Newton steps, fine matvecs, seconds) of one run."""
+    """(exit status, reason, Newton steps, fine matvecs, seconds, residual floor) of one run."""
     env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
     t = time.time()
     try:
         rc = subprocess.run([binary, "--problem", problem, "--quiet", "--json", out], env=env,
                             capture_output=True, timeout=timeout).returncode
     except subprocess.TimeoutExpired:
-        return 124, "timeout", -1, 0.0, time.time() - t
+        return 124, "timeout", -1, 0.0, time.time() - t, 0.0
     t = time.time() - t
     try:
         j = json.load(open(out))
-        return rc, j["reason"], j["newton_iterations"], j["counts"]["fine_matvecs_total"], t
+        return (rc, j["reason"], j["newton_iterations"], j["counts"]["fine_matvecs_total"], t,
+                j.get("residual_floor", 0.0))
     except (OSError, ValueError, KeyError):
-        return rc, "-", -1, 0.0, t
+        return rc, "-", -1, 0.0, t, 0.0
 
 
 def main():
@@ -124,6 +125,9 @@ def main():
         print(f"{b}: {ok} of {a.count} converged ({100.0 * ok / a.count:.0f} %); by reason: "
               + ", ".join(f"{k} {v}" for k, v in tally.most_common())
               + f"; median {sorted(r[4] for r in rows)[len(rows) // 2]:.2f} s a run")
+        floor = sum(1 for r in rows if r[0] == 0 and r[5] > 0)
+        if floor:
+            print(f"  {floor} of them converged to the level that r = S u - b~ resolves, above eps (residual_floor)")
         if odd:
             print(f"  neither converged nor an honest failure (exit status not 0 or 1): {' '.join(odd)}")
     if a.compare:

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <thread>
 #include <vector>
+#include <regex>
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -49,6 +50,14 @@ std::string slurp(const std::string& path) {
 }
 
 // a run ending with `status`, its output containing `says` (if given)
+// the Newton steps of a run's verdict line ("converged after N Newton
+// iterations" or "NOT CONVERGED after N ..."); -1 if there is none
+int newton_steps(const std::string& out) {
+  static const std::regex verdict("(converged|CONVERGED) after ([0-9]+) ");
+  std::smatch m;
+  return std::regex_search(out, m, verdict) ? std::stoi(m[2]) : -1;
+}
+
 void expect_run(const std::string& args, int status, const std::string& says, const std::string& env = "") {
   const CmdResult r = run(args, env);
   EXPECT_EQ(r.status, status) << args << "\n" << r.out;
@@ -352,6 +361,31 @@ TEST(TrescaDriver, ProblemsOfARandomSweepThatStagnatedConvergeWithAVerifiedAnswe
   for (const auto& c : cases) expect_verified_answer(c.name, c.json, c.note);
 }
 
+TEST(TrescaDriver, ProblemsWhoseEpsIsBelowWhatRResolvesConvergeToThatLevel) {
+  // Drawn by perf/robustness_sweep.py --seed 7 (RESULTS.md §0zr), rounded to
+  // 4 digits: elements 14 and 24 times longer than thick. With the default
+  // eps = 1e-6 N and forces of 1e5-1e7 N, |w| wandered at 1-4 eps (the
+  // bar) and at 3e-6 N on an r summed from the steps that a fresh r put at
+  // 6e-4 N (the plate), the contact states settled, until stagnation; each
+  // now converges to the level it stayed at, at most 1e-10 |b~|, confirmed
+  // with a fresh r and the final KKT check (semismooth.cpp: floor_stop)
+  const struct {
+    const char* name;
+    const char* json;
+  } cases[] = {
+      {"floor_bar",
+       R"({"mesh": {"dims": [35, 1, 4]}, "box": {"lengths": [4.27, 0.603, 0.03929], "origin": [0, 0, 0]},
+           "material": {"E": 1816000000.0, "nu": -0.1659},
+           "loads": {"traction": {"z1": [521300.0, 131900.0, -1099000.0], "x1": [-484100.0, -241800.0, 197500.0]}},
+           "friction": {"tresca": 526.9}, "obstacle": {"kind": "cylinder", "radius": 11.41, "y": 0.5141, "gap": 4.213e-06}})"},
+      {"floor_plate_fresh_r",
+       R"({"mesh": {"dims": [12, 9, 4]}, "box": {"lengths": [3.004, 0.1993, 0.04163], "origin": [0, 0, 0]},
+           "material": {"E": 308900000000.0, "nu": -0.3597},
+           "loads": {"traction": {"z1": [18760000.0, -7446000.0, -249400000.0]}},
+           "friction": {"tresca": 285500.0}, "obstacle": {"kind": "sphere", "radius": 1.538, "center": [0.07966, 0.1905], "gap": 6.145e-09}})"}};
+  for (const auto& c : cases) expect_verified_answer(c.name, c.json, "is finer than r = S u - b~ resolves");
+}
+
 TEST(TrescaDriver, WithoutLoadTheBodyStaysAtRest) {
   // b~ = 0: nested iteration (and the Coulomb fixed point) once stopped with
   // "an initial iterate u0 needs force_scale" (exit 2); u = 0, lambda = 0
@@ -441,34 +475,37 @@ TEST(TrescaDriver, ASlowFrontOfSeparationIsNotStagnation) {
   // step lets a node or two more separate (31 steps, |w| falling by 5-10 %
   // a step); before, "not converged (stagnation)" after 14 (no halving in
   // 10 steps)
-  auto steps = [](const std::string& out) {
-    const std::size_t at = out.find("converged after ");
-    return at == std::string::npos ? -1 : std::atoi(out.c_str() + at + 16);
-  };
   const CmdResult cold = run("tresca --dims 100x1x1 --phi 1e7 --quiet --no-nested");
   EXPECT_EQ(cold.status, 0) << cold.out;
-  EXPECT_GE(steps(cold.out), 25) << cold.out;  // (31 when written)
-  EXPECT_LE(steps(cold.out), 40) << cold.out;
+  EXPECT_GE(newton_steps(cold.out), 25) << cold.out;  // (31 when written)
+  EXPECT_LE(newton_steps(cold.out), 40) << cold.out;
   // stopped at the limit while the states still move, the run says so
   expect_run("tresca --dims 100x1x1 --phi 1e7 --quiet --no-nested --max-newton 10", 1,
              "note: the last step still changed the state of");
   // nested iteration (the coarser bar 50x1x1 first) places the front
   const CmdResult nested = run("tresca --dims 100x1x1 --phi 1e7 --quiet");
   EXPECT_EQ(nested.status, 0) << nested.out;
-  EXPECT_GE(steps(nested.out), 1) << nested.out;
-  EXPECT_LE(steps(nested.out), 8) << nested.out;  // (4 when written)
+  EXPECT_GE(newton_steps(nested.out), 1) << nested.out;
+  EXPECT_LE(newton_steps(nested.out), 8) << nested.out;  // (4 when written)
 }
 
 TEST(TrescaDriver, NearlyIncompressibleMaterialFailsFastAndSaysWhy) {
   // Q1 locks at nu -> 0.5 and the multigrid CGs cannot converge: the run
-  // must stop with the reason, not hang (the loose first residual passes;
-  // the boundary CG of the first step stops at its iteration limit, and
-  // no length of that step decreases the merit: stagnation, in 2 s)
+  // must stop with the reason, not hang (issue 11: 825 s before stagnation).
+  // The boundary CG of the first step stops at its iteration limit and no
+  // length of that step decreases the merit; the step is solved again with
+  // tighter inner solves (RESULTS.md §0zq), which lowers |v| 16-fold, and
+  // the second step's inner solve of K_ii fails at its iteration limit:
+  // inner_solver_failure after 2 steps, 12 s on 2 threads (before §0zq:
+  // stagnation after the first step, in 2 s)
   const CmdResult r = run("tresca --dims 16x8x8 --nu 0.49999 --quiet");
   EXPECT_EQ(r.status, 1) << r.out;
   EXPECT_NE(r.out.find("nearly incompressible"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("not converged (stagnation)"), std::string::npos) << r.out;
+  EXPECT_TRUE(r.out.find("not converged (stagnation)") != std::string::npos ||
+              r.out.find("not converged (inner_solver_failure)") != std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("NOT CONVERGED"), std::string::npos) << r.out;
+  EXPECT_LE(newton_steps(r.out), 3) << r.out;
 }
 
 TEST(TrescaDriver, AnAuxeticMaterialConvergesAndSaysItsInnerSolvesWereTightened) {
@@ -598,11 +635,7 @@ TEST(TrescaDriver, RestartsFromItsOwnContactCsv) {
   const CmdResult warm = run("tresca --level 7 --phi 2 --eps 1e-4 --initial " + csv);
   ASSERT_EQ(cold.status, 0) << cold.out;
   ASSERT_EQ(warm.status, 0) << warm.out;
-  auto steps = [](const std::string& out) {
-    const size_t at = out.find("converged after ");
-    return at == std::string::npos ? -1 : std::atoi(out.c_str() + at + 16);
-  };
-  EXPECT_LT(steps(warm.out), steps(cold.out)) << warm.out << cold.out;
+  EXPECT_LT(newton_steps(warm.out), newton_steps(cold.out)) << warm.out << cold.out;
   // the wrong mesh, a missing column, a broken value: one line naming it
   expect_error("tresca --level 6 --initial " + csv, "is not a contact node of this mesh");
   {

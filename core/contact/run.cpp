@@ -290,6 +290,8 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.problem = std::make_unique<Problem>(make_problem(spec));
   R.contact = opt.contact.phi.empty() ? contact_conditions(spec) : opt.contact;
   NewtonOptions newton = opt.newton;
+  // (a stop at a measured floor must stay within the final check's tolerance)
+  newton.floor_rtol = std::min(newton.floor_rtol, opt.kkt_rtol);
   Start start;
   start.given_u0 = newton.u0;
   start.given_lambda0 = newton.lambda0;

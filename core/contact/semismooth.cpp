@@ -436,8 +436,10 @@ class NewtonSolve {
   bool start();
   bool refresh(real rtol);
   ResidualNorms residual_at(Point& at);
+  void approximate();
   bool measure(int k);
   std::optional<NewtonReason> record(int k);
+  std::optional<NewtonReason> floor_stop(int k);
   std::optional<NewtonReason> newton_step();
   std::optional<NewtonReason> take_step();
   void check_step(const real* Sdu, bool hit_limit);
@@ -473,6 +475,9 @@ class NewtonSolve {
   real step_rhs = 0, step_target = 0;  // the last step's |r_F| and accuracy asked (StepOutcome)
   real last_missed = 0;                // the factor the last step missed its accuracy by (check_step), 0: met
   int last_watchdog = std::numeric_limits<int>::min() / 2;  // the last step the watchdog took whole
+  int last_change = 0;  // the last iteration whose step changed some node's state
+  int window_from = 0;  // the stagnation window's first iteration (floor_stop: r refreshed there)
+  real restart_merit = 0;  // |w| of the fresh r there
   real eta;
   // this iteration's |v̂|, merit |w| and tolerance
   real vnorm = 0, merit = 0, tol = 0;
@@ -571,6 +576,24 @@ ResidualNorms NewtonSolve::residual_at(Point& at) {
                             at.status.data());
 }
 
+// the approximation step at x: |v̂| and |w|, x's v̂, w, d and node states
+void NewtonSolve::approximate() {
+  ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
+  const ResidualNorms norms = residual_at(x);
+  merit = std::sqrt(S.sum(norms.consistent));
+  vnorm = opt.stop == StopRule::consistent ? merit : std::sqrt(S.sum(norms.paper));
+  if (opt.friction.differentiates_bound()) {
+    // the step's point on the Coulomb graph: its pressure d_4 sets the
+    // bound of its friction force (v̂, the residual, stays at lambda)
+    const real F = opt.friction.F;
+    const real* d4 = x.d.data() + 2 * p;
+    real* phi = x.phi.data();
+    for_each_entry("coulomb bound of d4", p, Cost{16, 1}, [=](index i) { phi[i] = F * d4[i]; });
+    approximation_step(p, ContactLaw{phi, gap.data(), opt.kink_contact}, scale_ptr, units.data(), x.u.data(),
+                       x.lambda.data(), x.r.data(), trial.v.data(), trial.w.data(), x.d.data(), x.status.data());
+  }
+}
+
 // 1. the approximation step at x = (u, lambda), r = S u - b̃, and the step's
 // forcing term; r is refreshed first if it is not accurate enough for them
 // (Tolerances). False: an inner solve failed.
@@ -579,22 +602,7 @@ bool NewtonSolve::measure(int k) {
   bool verifying = false;
   stop_verified = false;
   for (int pass = 0;; ++pass) {
-    {
-      ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
-      const ResidualNorms norms = residual_at(x);
-      merit = std::sqrt(S.sum(norms.consistent));
-      vnorm = opt.stop == StopRule::consistent ? merit : std::sqrt(S.sum(norms.paper));
-      if (opt.friction.differentiates_bound()) {
-        // the step's point on the Coulomb graph: its pressure d_4 sets the
-        // bound of its friction force (v̂, the residual, stays at lambda)
-        const real F = opt.friction.F;
-        const real* d4 = x.d.data() + 2 * p;
-        real* phi = x.phi.data();
-        for_each_entry("coulomb bound of d4", p, Cost{16, 1}, [=](index i) { phi[i] = F * d4[i]; });
-        approximation_step(p, ContactLaw{phi, gap.data(), opt.kink_contact}, scale_ptr, units.data(), x.u.data(),
-                           x.lambda.data(), x.r.data(), trial.v.data(), trial.w.data(), x.d.data(), x.status.data());
-      }
-    }
+    approximate();
     tol = std::max(opt.eps, opt.rtol * (k == 0 ? vnorm : R.history[0]));
     eta_k = forcing_term(opt, k, vnorm, k > 0 ? R.history[k - 1] : vnorm, eta, tol);
     // r must be accurate to a fraction of what the step resolves, and to
@@ -646,9 +654,13 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
                                 : index(S.sum(sum_over_entries("newton states changed", p, Cost{2, 1},
                                                                [=](index i) { return real(now[i] != before[i]); })));
   for_each_entry("newton states kept", p, Cost{2, 0}, [=](index i) { before[i] = now[i]; });
+  if (R.last_state_changes > 0) last_change = k;
   if (k >= opt.max_iterations) return NewtonReason::iteration_limit;
   const bool progress = R.last_state_changes > 0 && R.merit[k] < R.merit[k - 1];
-  if (!progress && stagnated(R.merit, opt.stagnation_window, std::max(R.monotone_from, 0))) {
+  auto stagnating = [&] { return stagnated(R.merit, opt.stagnation_window, std::max(R.monotone_from, window_from)); };
+  if (!progress && stagnating()) {
+    if (const auto stop = floor_stop(k)) return stop;
+    if (!stagnating()) return std::nullopt;  // (r refreshed: the window starts again)
     // the non-monotone search let Newton wander (NewtonOptions::line_search):
     // from here on each step must lower |w|, and stagnation is judged anew;
     // not at the floor of what r resolves, where no search makes progress
@@ -656,6 +668,50 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
     if (!opt.line_search || opt.line_search_memory == 0 || R.monotone_from >= 0 || at_floor)
       return NewtonReason::stagnation;
     R.monotone_from = k;
+  }
+  return std::nullopt;
+}
+
+// Stagnation at the floor of what r = S u - b̃ resolves for this problem,
+// as observed (NewtonOptions::floor_rtol). Where the window's steps changed
+// no node's state, Newton is in its local regime: a step solved to its
+// tolerance would cut |w| by its forcing term (1e-2 or less), so a |w|
+// that wanders at one level for stagnation_window steps is the error of
+// the r it is computed from. Where some |w| of the window is at most
+// floor_rtol |b̃| (elsewhere nothing changes), r is solved afresh at x (warm
+// from the body, to the tightest inner tolerance). Where that r's |w| is
+// within the window's level, and the level is at most floor_rtol |b̃|, x is
+// a solution to that level: converged, the level the tolerance
+// (NewtonResult::residual_floor). Where the fresh r is further from a
+// solution than the r summed from the steps, and above what r resolves (r
+// drifted: the increments carried more error than counted), Newton goes on
+// from the fresh r and the window starts again, once. Otherwise stagnation is judged as before,
+// from the fresh r. (Plates and blocks of elements 20-300 times longer
+// than wide, whose r resolves 3e-12 to 4e-11 |b̃|, not 1e-12, wandered at
+// 1-4 times eps = 1e-6 N until stagnation: RESULTS.md §0zr.)
+std::optional<NewtonReason> NewtonSolve::floor_stop(int k) {
+  const int w = opt.stagnation_window;
+  if (k - last_change < w || opt.floor_rtol <= 0 || opt.stop != StopRule::consistent ||
+      *std::min_element(R.merit.end() - w, R.merit.end()) > opt.floor_rtol * fscale)
+    return std::nullopt;
+  real level = std::max(*std::max_element(R.merit.end() - w, R.merit.end()), resolved());
+  const real summed = merit;
+  if (!refresh(1e-12)) return NewtonReason::inner_failure;
+  r_err = resolved();
+  approximate();
+  R.history.back() = R.merit.back() = merit;
+  if (merit <= tol) return NewtonReason::converged;
+  // (after a restart from a fresh r that Newton's steps did not halve: the
+  // fresh |w| is the level, r's error the same from step to step)
+  if (window_from > 0 && merit > 0.5 * restart_merit) level = std::max({level, merit, restart_merit});
+  if (merit <= level && level <= opt.floor_rtol * fscale) {
+    R.residual_floor = level;
+    R.tolerance = level;
+    return NewtonReason::converged;
+  }
+  if (merit > 2 * summed && merit > resolved() && window_from == 0) {
+    window_from = k;
+    restart_merit = merit;
   }
   return std::nullopt;
 }

@@ -92,6 +92,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["initial_iterate"] = R.initial_iterate.empty() ? Json(nullptr) : Json(R.initial_iterate);
   j["stopping_rule"] = N.stop == StopRule::consistent ? "consistent" : "paper";
   j["tolerance"] = N.tolerance;
+  j["residual_floor"] = N.residual_floor;  // > 0: converged at this level of what r resolves, above eps [N]
   j["residual_history"] = N.history;
   j["step_lengths"] = N.step_lengths;
   j["inner_iterations_history"] = N.inner_history;
