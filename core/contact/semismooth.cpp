@@ -685,10 +685,11 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
 // (NewtonResult::residual_floor). Where the fresh r is further from a
 // solution than the r summed from the steps, and above what r resolves (r
 // drifted: the increments carried more error than counted), Newton goes on
-// from the fresh r and the window starts again, once. Otherwise stagnation is judged as before,
-// from the fresh r. (Plates and blocks of elements 20-300 times longer
-// than wide, whose r resolves 3e-12 to 4e-11 |b̃|, not 1e-12, wandered at
-// 1-4 times eps = 1e-6 N until stagnation: RESULTS.md §0zr.)
+// from the fresh r and the window starts again, once. Otherwise stagnation
+// is judged as before, from the fresh r. (Plates and blocks of elements
+// 7-60 times longer than wide, whose r resolves 2e-12 to 6e-11 |b̃|, not
+// 1e-12, wandered at 1-4 times eps = 1e-6 N until stagnation: RESULTS.md
+// §0zr.)
 std::optional<NewtonReason> NewtonSolve::floor_stop(int k) {
   const int w = opt.stagnation_window;
   if (k - last_change < w || opt.floor_rtol <= 0 || opt.stop != StopRule::consistent ||

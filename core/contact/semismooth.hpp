@@ -149,10 +149,10 @@ struct NewtonOptions {
   // Runs that converge without it never reach the test and are unchanged.
   // Off: full steps, and only the second test.
   bool line_search = true;
-  // A stagnation at the floor of what r resolves, measured where it
-  // happens (semismooth.cpp: floor_stop), counts as converged where that
-  // floor is at most floor_rtol |b̃| (RunOptions::kkt_rtol's default: the
-  // final check's tolerance); 0: never.
+  // A stagnation at the floor of what r resolves, the level |w| stayed at
+  // with the contact states settled (semismooth.cpp: floor_stop), counts
+  // as converged where that level is at most floor_rtol |b̃| (run_tresca
+  // caps it at RunOptions::kkt_rtol, the final check's tolerance); 0: never.
   real floor_rtol = 1e-10;
   bool kink_contact = true;  // contact_maps.hpp: ContactLaw::kink_contact
   int line_search_memory = 5;
@@ -226,8 +226,8 @@ struct NewtonResult {
   int watchdog_steps = 0;        // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
   int redone_steps = 0;          // steps solved again with tighter inner solves (their first stopped at the outer limit)
   int monotone_from = -1;        // the iteration from which the line search was monotone (-1: never; line_search)
-  // > 0: converged at this floor of what r resolves [N], measured at the
-  // last iterate above eps (NewtonOptions::floor_rtol); tolerance is then it
+  // > 0: converged at this floor of what r resolves [N], above eps: the
+  // level |w| stayed at (NewtonOptions::floor_rtol); tolerance is then it
   real residual_floor = 0;
   index last_state_changes = 0;  // nodes whose contact or stick state the last step changed (all ranks)
   // the factor (>= 1) by which the steps' inner tolerances were tightened
