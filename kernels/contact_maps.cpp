@@ -69,7 +69,11 @@ ResidualNorms approximation_step(index p, const ContactLaw& law, const real* sca
   // with the thread count. (Oracles: the closed forms and the thread counts
   // in tests/test_newton.cpp, ApproximationStep; the dense reference Newton
   // there.)
-  auto sweep = [&](auto has_units, auto has_scale) {
+  auto sweep = [&](auto units_tag, auto scale_tag) {
+    // (the choice as constants, not the tags: a tag captured in the body
+    // is a byte and seven of stale stack, which the device guard read as a
+    // host heap address, RESULTS.md §0zr)
+    constexpr bool has_units = decltype(units_tag)::value, has_scale = decltype(scale_tag)::value;
     // vector loop (tests/check_vectorised.py)
     for_each_entry("approximation step", p, kApproximationStepCost, [=](index i) {
       // x3 enters through F_4 = u_z + g

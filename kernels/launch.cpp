@@ -494,7 +494,11 @@ bool device_guarded() { return guard().on; }
 // not a Field), it reads the body: each 8-byte word that holds an address
 // aligned as malloc returns them is compared with malloc's main heap,
 // where small host arrays live. (A closure's padding may hold stale stack
-// or library addresses, so only the heap's range is asked about.)
+// or library addresses, so only the heap's range is asked about. It may
+// hold a stale heap address too: a body that captured two empty tag
+// objects, a byte and seven of padding each, failed the check with
+// nothing but device arrays in it (contact_maps.cpp, RESULTS.md §0zr);
+// bodies take such choices as constants, not captures.)
 void detail::check_device_body(const char* kernel, const void* body, std::size_t bytes) {
   const Guard& g = guard();
   if (!g.on) return;
