@@ -498,6 +498,10 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
   if (N.watchdog_steps > 0)
     std::printf("note: %d Newton steps were taken whole where no step length decreased |w| (the line search's watchdog)\n",
                 N.watchdog_steps);
+  if (R.resumed_from >= 0)
+    std::printf("note: the final check did not confirm the stop after step %d (|w| <= eps, a KKT field above it):\n"
+                "      Newton went on to eps %.1e, %d more steps\n",
+                R.resumed_from, R.resumed_eps, N.iterations - R.resumed_from);
   if (N.redone_steps > 0)
     std::printf("note: %d Newton steps were solved again with tighter inner solves (the first solve stopped at the "
                 "outer CG's limit and no length of it lowered |w|)\n",

@@ -386,6 +386,22 @@ TEST(TrescaDriver, ProblemsWhoseEpsIsBelowWhatRResolvesConvergeToThatLevel) {
   for (const auto& c : cases) expect_verified_answer(c.name, c.json, "is finer than r = S u - b~ resolves");
 }
 
+TEST(TrescaDriver, AStopTheFinalCheckDoesNotConfirmGoesOn) {
+  // perf/robustness_sweep.py --seed 11, problem 5 (RESULTS.md §0zr), rounded
+  // to 4 digits: an auxetic bar lifted off the plane stopped at |w| 2.6e-7
+  // N <= eps, and the final check found a sliding node's friction direction
+  // 1.4e-6 N off (kkt_check_failed). Newton now goes on from its own result
+  // with eps lowered by the factor the check missed: one more step, and the
+  // check passes against the eps asked for (run.cpp: resume_after_check)
+  expect_verified_answer(
+      "check_resumed",
+      R"({"mesh": {"dims": [19, 7, 4]}, "box": {"lengths": [2.229, 0.1265, 0.133], "origin": [0, 0, 0]},
+          "material": {"E": 31220000.0, "nu": -0.5081},
+          "loads": {"traction": {"z1": [580.7, 2953.0, 5624.0], "x1": [-3100.0, -2111.0, 2908.0]}},
+          "friction": {"tresca": 432.8}, "obstacle": {"kind": "plane", "gap": 1.857e-07, "slope": [0.0009628, 2.126e-05]}})",
+      "note: the final check did not confirm the stop after step");
+}
+
 TEST(TrescaDriver, WithoutLoadTheBodyStaysAtRest) {
   // b~ = 0: nested iteration (and the Coulomb fixed point) once stopped with
   // "an initial iterate u0 needs force_scale" (exit 2); u = 0, lambda = 0

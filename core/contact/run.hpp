@@ -132,6 +132,10 @@ struct RunResult {
   // the two residuals that decided it (included in fine_matvecs_total)
   std::string initial_iterate;
   double choice_fine_matvecs = 0;
+  // a stop the final check did not confirm: the Newton step it went on
+  // from, and the eps it went on to (run.cpp: resume_after_check); -1: none
+  int resumed_from = -1;
+  real resumed_eps = 0;
   long long newton_steps() const { return coulomb() ? coulomb_loop.newton_steps : newton.iterations; }
   double newton_fine_matvecs() const { return coulomb() ? coulomb_loop.fine_matvecs : newton.fine_matvecs; }
   double fine_matvecs_per_newton_step() const {

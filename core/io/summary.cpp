@@ -149,6 +149,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                  {"watchdog_steps", N.watchdog_steps},
                  {"redone_steps", N.redone_steps},
                  {"monotone_from", N.monotone_from},
+                 {"resumed_from", R.resumed_from},
                  {"last_state_changes", N.last_state_changes},
                  {"inner_tightening", N.inner_tightening},
                  {"fine_matvecs_per_newton_step", R.fine_matvecs_per_newton_step()},
