@@ -223,9 +223,6 @@ SolveStats scale_of_load(const SteklovPoincare& S, const RunOptions& opt, Newton
   return cond;
 }
 
-// The contact problem by the friction law's method: one semismooth* Newton
-// solve (Tresca; Coulomb by Newton with the bound following lambda), or
-// Coulomb's fixed point of Tresca solves. `law` ends with the bound used.
 // Coulomb: max_i |phi_i - F lambda_i| of the run's solution, over the ranks
 void coulomb_consistency(const SteklovPoincare& S, const RunOptions& opt, const ContactConditions& law, RunResult& R) {
   if (!R.coulomb()) return;
@@ -236,6 +233,9 @@ void coulomb_consistency(const SteklovPoincare& S, const RunOptions& opt, const 
   R.coulomb_consistency = S.max(R.coulomb_consistency);
 }
 
+// The contact problem by the friction law's method: one semismooth* Newton
+// solve (Tresca; Coulomb by Newton with the bound following lambda), or
+// Coulomb's fixed point of Tresca solves. `law` ends with the bound used.
 void solve_contact(const SteklovPoincare& S, const RunOptions& opt, ContactConditions& law, NewtonOptions& newton,
                    RunResult& R) {
   if (opt.friction.bound_follows_lambda()) {
