@@ -49,7 +49,6 @@ std::string slurp(const std::string& path) {
   return s.str();
 }
 
-// a run ending with `status`, its output containing `says` (if given)
 // the Newton steps of a run's verdict line ("converged after N Newton
 // iterations" or "NOT CONVERGED after N ..."); -1 if there is none
 int newton_steps(const std::string& out) {
@@ -58,6 +57,7 @@ int newton_steps(const std::string& out) {
   return std::regex_search(out, m, verdict) ? std::stoi(m[2]) : -1;
 }
 
+// a run ending with `status`, its output containing `says` (if given)
 void expect_run(const std::string& args, int status, const std::string& says, const std::string& env = "") {
   const CmdResult r = run(args, env);
   EXPECT_EQ(r.status, status) << args << "\n" << r.out;

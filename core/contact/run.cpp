@@ -233,6 +233,17 @@ void coulomb_consistency(const SteklovPoincare& S, const RunOptions& opt, const 
   R.coulomb_consistency = S.max(R.coulomb_consistency);
 }
 
+// Coulomb by one Newton solve whose bound followed lambda: that solve is the
+// loop's account, and its last bound the law's
+void one_solve_as_coulomb_loop(ContactConditions& law, RunResult& R) {
+  law.phi = R.newton.phi;
+  R.coulomb_loop.iterations = 1;
+  R.coulomb_loop.reason = R.newton.converged() ? CoulombReason::converged : CoulombReason::tresca_failed;
+  R.coulomb_loop.newton_steps = R.newton.iterations;
+  R.coulomb_loop.inner_iterations = R.newton.inner_iterations;
+  R.coulomb_loop.fine_matvecs = R.newton.fine_matvecs;
+}
+
 // The contact problem by the friction law's method: one semismooth* Newton
 // solve (Tresca; Coulomb by Newton with the bound following lambda), or
 // Coulomb's fixed point of Tresca solves. `law` ends with the bound used.
@@ -241,12 +252,7 @@ void solve_contact(const SteklovPoincare& S, const RunOptions& opt, ContactCondi
   if (opt.friction.bound_follows_lambda()) {
     newton.friction = opt.friction;
     R.newton = semismooth_newton(S, law, newton);
-    law.phi = R.newton.phi;
-    R.coulomb_loop.iterations = 1;
-    R.coulomb_loop.reason = R.newton.converged() ? CoulombReason::converged : CoulombReason::tresca_failed;
-    R.coulomb_loop.newton_steps = R.newton.iterations;
-    R.coulomb_loop.inner_iterations = R.newton.inner_iterations;
-    R.coulomb_loop.fine_matvecs = R.newton.fine_matvecs;
+    one_solve_as_coulomb_loop(law, R);
   } else if (opt.friction.is_coulomb()) {
     CoulombOptions co;
     co.F = opt.friction.F;
@@ -336,18 +342,12 @@ bool resume_after_check(const SteklovPoincare& S, const RunOptions& opt, Contact
       shifted.elapsed += t0;
       newton.progress(shifted);
     };
-  if (opt.friction.bound_follows_lambda()) again.friction = opt.friction;
+  // (newton.friction is the run's: solve_contact)
   NewtonResult more = semismooth_newton(S, law, again);
   R.resumed_from = k0;
   R.resumed_eps = again.eps;
   append_steps(R.newton, std::move(more));
-  if (opt.friction.bound_follows_lambda()) {
-    law.phi = R.newton.phi;
-    R.coulomb_loop.reason = R.newton.converged() ? CoulombReason::converged : CoulombReason::tresca_failed;
-    R.coulomb_loop.newton_steps = R.newton.iterations;
-    R.coulomb_loop.inner_iterations = R.newton.inner_iterations;
-    R.coulomb_loop.fine_matvecs = R.newton.fine_matvecs;
-  }
+  if (opt.friction.bound_follows_lambda()) one_solve_as_coulomb_loop(law, R);
   return true;
 }
 

@@ -477,7 +477,6 @@ class NewtonSolve {
   int last_watchdog = std::numeric_limits<int>::min() / 2;  // the last step the watchdog took whole
   int last_change = 0;  // the last iteration whose step changed some node's state
   int window_from = 0;  // the stagnation window's first iteration (floor_stop: r refreshed there)
-  real restart_merit = 0;  // |w| of the fresh r there
   real eta;
   // this iteration's |v̂|, merit |w| and tolerance
   real vnorm = 0, merit = 0, tol = 0;
@@ -704,16 +703,16 @@ std::optional<NewtonReason> NewtonSolve::floor_stop(int k) {
   if (merit <= tol) return NewtonReason::converged;
   // (after a restart from a fresh r that Newton's steps did not halve: the
   // fresh |w| is the level, r's error the same from step to step)
-  if (window_from > 0 && merit > 0.5 * restart_merit) level = std::max({level, merit, restart_merit});
+  if (window_from > 0) {
+    const real restart_merit = R.merit[size_t(window_from)];  // (the fresh r's |w| there)
+    if (merit > 0.5 * restart_merit) level = std::max({level, merit, restart_merit});
+  }
   if (merit <= level && level <= opt.floor_rtol * fscale) {
     R.residual_floor = level;
     R.tolerance = level;
     return NewtonReason::converged;
   }
-  if (merit > 2 * summed && merit > resolved() && window_from == 0) {
-    window_from = k;
-    restart_merit = merit;
-  }
+  if (merit > 2 * summed && merit > resolved() && window_from == 0) window_from = k;
   return std::nullopt;
 }
 
