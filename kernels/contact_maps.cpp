@@ -28,6 +28,16 @@ inline real max0(real x) { return real(0) < x ? x : real(0); }
 inline real step_factor(real s, real phi, real z1, real z2) {
   return max0(1 - phi / (s * std::sqrt(z1 * z1 + z2 * z2)));
 }
+// a node's envelope term e(u, r) (contact_maps.hpp: envelope_change) at
+// stiffness s, bound phi and gap g, from its minimiser y: each a scalar
+inline real envelope_term(real s, real phi, real g, real u1, real u2, real u3, real r1, real r2, real r3) {
+  const real z1 = u1 - r1 / s, z2 = u2 - r2 / s;
+  const real t = step_factor(s, phi, z1, z2);
+  const real e1 = t * z1 - u1, e2 = t * z2 - u2;
+  const real e3 = max0(u3 + g - r3 / s) - (u3 + g);  // y_z − u_z
+  return r1 * e1 + r2 * e2 + r3 * e3 + real(0.5) * s * (e1 * e1 + e2 * e2 + e3 * e3) +
+         phi * t * std::sqrt(z1 * z1 + z2 * z2);
+}
 inline bool in_contact(real c, bool kink_contact) {
   // (the kink as a bitwise term: a choice between two comparisons is one
   // GCC 12 does not vectorise)
@@ -50,6 +60,23 @@ StateCounts count_states(index p, const std::uint8_t* status) {
 
 void coulomb_bound(index p, real F, const real* lambda, real* phi) {
   for_each_entry("coulomb bound", p, Cost{16, 2}, [=](index i) { phi[i] = F * (lambda[i] > 0 ? lambda[i] : real(0)); });
+}
+
+EnvelopeChange envelope_change(index p, const ContactLaw& law, const real* scale, real a, const real* u, const real* r,
+                               const real* du, const real* Sdu) {
+  TRESCA_ASSERT(p >= 0 && (p == 0 || (law.phi != nullptr && law.gap != nullptr && scale != nullptr)));
+  // a node's term at u + b du, r + b S du (b = 0: at u itself), returned by
+  // value (no local of a device body has its address taken, above)
+  auto term = [=](index i, real b) {
+    return envelope_term(scale[i], law.phi[i], law.gap[i], u[i] + b * du[i], u[p + i] + b * du[p + i],
+                         u[2 * p + i] + b * du[2 * p + i], r[i] + b * Sdu[i], r[p + i] + b * Sdu[p + i],
+                         r[2 * p + i] + b * Sdu[2 * p + i]);
+  };
+  EnvelopeChange e;
+  e.change = sum_over_entries("envelope change", p, kEnvelopeChangeCost, [=](index i) { return term(i, a) - term(i, 0); });
+  e.size = sum_over_entries("envelope size", p, kEnvelopeChangeCost,
+                            [=](index i) { return std::abs(term(i, a)) + std::abs(term(i, 0)); });
+  return e;
 }
 
 ResidualNorms approximation_step(index p, const ContactLaw& law, const real* scale, const real* units, const real* u,

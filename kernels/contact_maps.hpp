@@ -82,6 +82,26 @@ struct ResidualNorms {
 ResidualNorms approximation_step(index p, const ContactLaw& law, const real* scale, const real* units, const real* u,
                                  const real* lambda, const real* r, real* v, real* w, real* d, std::uint8_t* status);
 
+// The contact part of the forward-backward envelope of the Tresca problem
+// min ½ uᵀS u − b̃ᵀu + Σ phi_i |u_τ| subject to u_z + g >= 0, in the metric of
+// the step's stiffness s_i (the line search's merit where it resolves,
+// semismooth.cpp): per node
+//   e_i(u, r) = min over y with y_z + g_i >= 0 of
+//               r·(y − u) + ½ s_i |y − u|² + phi_i |y_τ|,
+// r = S u − b̃, whose minimiser y is the proximal point of the approximation
+// step (y_τ = max(0, 1 − phi/(s |z|)) z with z = u_τ − r_τ/s, y_z + g =
+// max(0, u_z + g − r_z/s)). The envelope is ½ uᵀ(r − b̃) + Σ e_i; along
+// u + a du, r + a S du its change is a du·r + ½ a² du·S du plus
+//   change = Σ e_i(u + a du, r + a S du) − e_i(u, r)
+// returned here with size = Σ |e_i(u + a du, ...)| + |e_i(u, ...)|, the
+// terms' magnitude, which bounds the sum's rounding.
+struct EnvelopeChange {
+  real change = 0, size = 0;
+};
+constexpr Cost kEnvelopeChangeCost{128, 80};  // per contact node and sum: reads u, r, du, S du, phi, gap, s
+EnvelopeChange envelope_change(index p, const ContactLaw& law, const real* scale, real a, const real* u, const real* r,
+                               const real* du, const real* Sdu);
+
 // The 2x2 block H_1 of a sliding node from d_12 (entries h11, h12, h22).
 inline void sliding_block(real phi, real d1, real d2, real& h11, real& h12, real& h22) {
   const real n2 = d1 * d1 + d2 * d2;

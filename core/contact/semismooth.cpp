@@ -411,16 +411,26 @@ void report_progress(const SteklovPoincare& S, const NewtonResult& R, const Poin
   progress(pr);
 }
 
-// The non-monotone (GLL) backtracking line search: the first alpha = 2^-j,
-// j = 0 .. halvings, whose merit_at(alpha) <= (1 - 1e-4 alpha) times the
-// largest of the last memory + 1 merits; 0 if there is none
-real line_search(const std::vector<real>& merits, int memory, int halvings, const std::function<real(real)>& merit_at) {
+// The backtracking line search: the first alpha = 2^-j, j = 0 .. halvings,
+// that lowers the forward-backward envelope where envelope_at(alpha)
+// resolves its change, and elsewhere (and without envelope_at) whose
+// merit_at(alpha) <= (1 - 1e-4 alpha) times the largest of the last
+// memory + 1 merits (non-monotone, GLL); where the envelope rises at every
+// length (s below S's scale: not a descent direction), the first alpha by
+// |w| alone; 0 if there is none
+real line_search(const std::vector<real>& merits, int memory, int halvings, const std::function<real(real)>& merit_at,
+                 const std::function<std::optional<real>(real)>& envelope_at) {
   const int m = std::min<int>(memory + 1, int(merits.size()));
   const real reference = *std::max_element(merits.end() - m, merits.end());
   real alpha = 1;
-  for (int j = 0; j <= halvings; ++j, alpha *= 0.5)
-    if (merit_at(alpha) <= (1 - 1e-4 * alpha) * reference) return alpha;
-  return 0;
+  for (int j = 0; j <= halvings; ++j, alpha *= 0.5) {
+    if (const std::optional<real> change = envelope_at ? envelope_at(alpha) : std::nullopt) {
+      if (*change < 0) return alpha;
+    } else if (merit_at(alpha) <= (1 - 1e-4 * alpha) * reference) {
+      return alpha;
+    }
+  }
+  return envelope_at ? line_search(merits, memory, halvings, merit_at, {}) : 0;
 }
 
 // One semismooth* Newton solve (semismooth_newton): its state and its steps.
@@ -443,6 +453,7 @@ class NewtonSolve {
   std::optional<NewtonReason> newton_step();
   std::optional<NewtonReason> take_step();
   void check_step(const real* Sdu, bool hit_limit);
+  std::function<std::optional<real>(real)> envelope_along_step(const real* Sdu);
 
   const SteklovPoincare& S;
   const NewtonOptions& opt;
@@ -784,7 +795,7 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
       });
       ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
       return std::sqrt(S.sum(residual_at(trial).consistent));
-    });
+    }, envelope_along_step(Sdu));
     if (alpha == 0 && last_step_hit_limit && work.tightening > step_tightening && !redo) {
       // a step whose outer CG stopped at its limit on S products too inexact
       // to converge (check_step has just tightened the inner solves by the
@@ -815,6 +826,31 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
   r_fresh = false;
   axpy(nf, alpha, Edu, R.body.data());
   return std::nullopt;
+}
+
+// The envelope's change along the step (NewtonOptions::envelope_merit), or
+// none where it does not apply: the paper's unscaled step, and a Coulomb
+// bound that follows lambda (no energy is minimised there). Its change at
+// alpha is alpha du·r + ½ alpha² du·S du + the contact terms' change
+// (contact_maps.hpp: envelope_change), unresolved (nullopt) where it is
+// within 1e-12 of its terms' magnitude: near the solution, where the
+// envelope's change is of the order of |w|² / s, it leaves the decision
+// to |w|.
+std::function<std::optional<real>(real)> NewtonSolve::envelope_along_step(const real* Sdu) {
+  if (!opt.envelope_merit || !scale_ptr || opt.friction.bound_follows_lambda()) return {};
+  const real* u = x.u.data();
+  const real* r = x.r.data();
+  const real* d = du.data();
+  const real dr = S.sum(dot(n3, d, r)), dsd = S.sum(dot(n3, d, Sdu));
+  const real cross = std::sqrt(S.sum(dot(n3, d, d)) * S.sum(dot(n3, r, r)));
+  const ContactLaw law{x.phi.data(), gap.data(), opt.kink_contact};
+  return [=](real a) -> std::optional<real> {
+    ScopedTimer t(Kernel::contact_maps, 2 * double(p) * kEnvelopeChangeCost);
+    const EnvelopeChange e = envelope_change(p, law, scale_ptr, a, u, r, d, Sdu);
+    const real change = a * dr + real(0.5) * a * a * dsd + S.sum(e.change);
+    if (std::abs(change) <= 1e-12 * (a * cross + S.sum(e.size))) return std::nullopt;
+    return change;
+  };
 }
 
 // The step's system checked with the fresh S Δu (of the whole step, less

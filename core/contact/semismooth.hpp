@@ -17,7 +17,8 @@
 //     Δλ = (S Δu)_z − v_3 on contact nodes.
 //  3. S Δu and E Δu from one application of S to the whole step, warm from
 //     the outer CG's running E Δu; then the step's length alpha by the
-//     non-monotone line search on |w| (NewtonOptions::line_search; r, lambda
+//     line search on the envelope, or on |w| near the solution
+//     (NewtonOptions::line_search, envelope_merit; r, lambda
 //     and U are linear along the step, so trial points cost no solve):
 //     x += alpha Δ, r += alpha S Δu, U += alpha E Δu.
 // Tolerances. The step is inexact: CG stops at eta_k |r_F| (forcing term,
@@ -149,6 +150,20 @@ struct NewtonOptions {
   // Runs that converge without it never reach the test and are unchanged.
   // Off: full steps, and only the second test.
   bool line_search = true;
+  // Far from the solution the search's merit is the problem's own: the
+  // forward-backward envelope of the Tresca energy in the step's metric s
+  // (contact_maps.hpp: envelope_change), a continuous function of u whose
+  // minimiser is the solution and along which Newton's direction descends
+  // (it is the envelope's Newton direction where s bounds S). |w| is not
+  // such a merit: a full step that crossed many nodes' kinks could raise
+  // the energy while |w| fell, and Newton cycled or crept (a 25x4x7 plate
+  // pressed and sheared over a gap: 50 steps, 2e6 N left; with the
+  // envelope 7 steps; RESULTS.md §0zs). A length is taken where the
+  // envelope falls; where its change is below what its terms resolve
+  // (near the solution, and a step that moves only lambda) |w| decides as
+  // above. Only where an energy is minimised: the scaled step with a bound
+  // that does not follow lambda (Tresca, Coulomb's fixed-point loop).
+  bool envelope_merit = true;
   // A stagnation at the floor of what r resolves, the level |w| stayed at
   // with the contact states settled (semismooth.cpp: floor_stop), counts
   // as converged where that level is at most floor_rtol |b̃| (run_tresca
