@@ -53,6 +53,9 @@ const char* kHelp =
     "                     (default 1e-6, absolute; --table: on the paper's |v|, its rule (11))\n"
     "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
     "  --max-newton N     Newton iteration limit (default 50)\n"
+    "  --merit envelope|residual  the line search's merit far from the solution: the forward-\n"
+    "                     backward envelope of the Tresca energy (default) or |w| alone; |w|\n"
+    "                     decides near the solution either way\n"
     "  --scaling paper|diagonal  metric of the approximation step: the paper's (forces and\n"
     "                     displacements added as numbers; needs near-exact steps) or the\n"
     "                     diagonal of K_cc per node (default; with --table: paper)\n"
@@ -157,7 +160,7 @@ void read_initial_iterate(const Args& a, Command& c) {
   c.opt.newton.lambda0 = &c.initial_lambda;
 }
 
-// --eps, --max-newton, --outer-pc, --scaling (with --table: the paper's literal method)
+// --eps, --max-newton, --outer-pc, --merit, --scaling (with --table: the paper's literal method)
 void newton_options_from(const Args& a, bool table, NewtonOptions& n) {
   n.eps = a.real_value("--eps", 1e-6);
   if (!(n.eps > 0)) throw std::invalid_argument("--eps " + a.str("--eps") + " must be > 0");
@@ -167,6 +170,10 @@ void newton_options_from(const Args& a, bool table, NewtonOptions& n) {
   const std::string pc = a.str("--outer-pc", "mg");
   if (pc != "mg" && pc != "none") throw std::invalid_argument("--outer-pc '" + pc + "' must be mg or none");
   n.outer_pc = pc == "mg" ? OuterPreconditioner::multigrid : OuterPreconditioner::none;
+  const std::string merit = a.str("--merit", "envelope");
+  if (merit != "envelope" && merit != "residual")
+    throw std::invalid_argument("--merit '" + merit + "' must be envelope or residual");
+  n.envelope_merit = merit == "envelope";
   const std::string sc = a.str("--scaling", table ? "paper" : "diagonal");
   if (sc != "paper" && sc != "diagonal") throw std::invalid_argument("--scaling '" + sc + "' must be paper or diagonal");
   if (sc != "paper") return;
@@ -273,6 +280,9 @@ void parse_command(const Args& a, const Comm& comm, Command& c) {
   if (a.has("--coulomb-method") && !c.opt.friction.is_coulomb())
     c.no_effect.push_back("--coulomb-method chooses how Coulomb friction is solved; this run is Tresca (--coulomb F)");
   if (a.has("--no-nested") && table) c.no_effect.push_back("--no-nested: --table never nests (the paper's cold start)");
+  if (a.has("--merit") && (c.opt.newton.scaling != StepScaling::diagonal || c.opt.friction.bound_follows_lambda()))
+    c.no_effect.push_back("--merit: the envelope is the merit of the scaled step (--scaling diagonal) with a bound that "
+                          "does not follow lambda (Tresca, --coulomb-method fixed-point); this run uses |w| alone");
   c.quiet = a.has("--quiet");
   c.profile = a.has("--profile");
   c.json_path = a.str("--json");
@@ -620,7 +630,7 @@ int main(int argc, char** argv) {
                  {"--level", "--dims", "--phi", "--gap", "--eps", "--E", "--nu", "--max-newton", "--threads", "--json",
                   "--contact-csv", "--vtk", "--table", "--outer-pc", "--mg-precision", "--mg-degree", "--scaling",
                   "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem", "--gap-file",
-                  "--vtk-format", "--initial", "--device"},
+                  "--vtk-format", "--initial", "--device", "--merit"},
                  {"--quiet", "--profile", "--no-nested", "--vtk-every-iteration"});
     if (answered_help_or_version(a, "tresca", kHelp)) return 0;
     parse_command(a, comm, c);

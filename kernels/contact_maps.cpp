@@ -66,9 +66,13 @@ EnvelopeChange envelope_change(index p, const ContactLaw& law, const real* scale
                                const real* du, const real* Sdu) {
   TRESCA_ASSERT(p >= 0 && (p == 0 || (law.phi != nullptr && law.gap != nullptr && scale != nullptr)));
   // a node's term at u + b du, r + b S du (b = 0: at u itself), returned by
-  // value (no local of a device body has its address taken, above)
+  // value (no local of a device body has its address taken, above); the
+  // law's two arrays taken, not the law (its bool's padding is stale stack
+  // in the body's copy, which the device guard reads, §0zr)
+  const real* phi = law.phi;
+  const real* gap = law.gap;
   auto term = [=](index i, real b) {
-    return envelope_term(scale[i], law.phi[i], law.gap[i], u[i] + b * du[i], u[p + i] + b * du[p + i],
+    return envelope_term(scale[i], phi[i], gap[i], u[i] + b * du[i], u[p + i] + b * du[p + i],
                          u[2 * p + i] + b * du[2 * p + i], r[i] + b * Sdu[i], r[p + i] + b * Sdu[p + i],
                          r[2 * p + i] + b * Sdu[2 * p + i]);
   };

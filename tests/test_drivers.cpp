@@ -66,15 +66,17 @@ void expect_run(const std::string& args, int status, const std::string& says, co
   }
 }
 
-// `tresca --quiet --problem` on a problem file of these contents: a run
-// that converged with a verified answer (the KKT check ok) and says `note`
-void expect_verified_answer(const std::string& name, const std::string& json, const char* note = nullptr) {
+// `tresca --quiet --problem` on a problem file of these contents (and
+// `options`): a run that converged with a verified answer (the KKT check
+// ok) and says `note`
+void expect_verified_answer(const std::string& name, const std::string& json, const char* note = nullptr,
+                            const std::string& options = "") {
   const std::string file = ::testing::TempDir() + "/" + name + ".json";
   {
     std::ofstream f(file);
     f << json;
   }
-  const CmdResult r = run("tresca --quiet --problem " + file);
+  const CmdResult r = run("tresca --quiet --problem " + file + " " + options);
   EXPECT_EQ(r.status, 0) << name << "\n" << r.out;
   EXPECT_NE(r.out.find("converged after"), std::string::npos) << name << "\n" << r.out;
   EXPECT_NE(r.out.find(": ok\n"), std::string::npos) << name << "\n" << r.out;  // the KKT check
@@ -105,6 +107,7 @@ TEST(ElasticDriver, RejectsBadInputWithOneLineNamingTheValue) {
   expect_error("elastic --dims axbxc", "axbxc");
   expect_error("elastic --device tpu", "tpu");
   expect_error("tresca --device tpu", "tpu");
+  expect_error("tresca --merit energy", "'energy' must be envelope or residual");
 #ifndef TRESCA_OFFLOAD
   expect_error("elastic --device gpu", "-DTRESCA_OFFLOAD=ON");
   expect_error("tresca --device gpu", "-DTRESCA_OFFLOAD=ON");
@@ -174,6 +177,8 @@ TEST(TrescaDriver, RejectsBadOptions) {
 TEST(TrescaDriver, WarnsAboutOptionsWithoutEffect) {
   expect_run("tresca --dims 4x2x2 --quiet --coulomb-method lagged", 0, "warning: no effect: --coulomb-method");
   expect_run("tresca --table 1-1 --no-nested", 0, "warning: no effect: --no-nested");
+  expect_run("tresca --dims 4x2x2 --quiet --coulomb 0.3 --merit residual", 0, "warning: no effect: --merit");
+  expect_run("tresca --dims 4x2x2 --quiet --scaling paper --merit envelope", 0, "warning: no effect: --merit");
   const CmdResult quiet = run("tresca --dims 4x2x2 --quiet --coulomb 0.3 --coulomb-method lagged");
   EXPECT_EQ(quiet.status, 0) << quiet.out;
   EXPECT_EQ(quiet.out.find("warning: no effect"), std::string::npos) << quiet.out;
@@ -321,8 +326,10 @@ TEST(TrescaDriver, ProblemsOfARandomSweepThatStagnatedConvergeWithAVerifiedAnswe
   // Drawn by perf/robustness_sweep.py (RESULTS.md §0zq), rounded to 4 digits.
   // A 6x17x6 block on a cylinder: semismooth Newton cycled between 17 and 18
   // nodes in contact, each step's |w| inside the non-monotone window, until
-  // the stagnation test ended it; the search now turns monotone there (the
-  // answer agrees to 1e-10 with the one plain CG's steps found). A plate of
+  // the stagnation test ended it; a search on |w| alone now turns monotone
+  // there (the answer agrees to 1e-10 with the one plain CG's steps found:
+  // 36 steps), and one on the energy's envelope does not cycle (9 steps,
+  // RESULTS.md §0zs). A plate of
   // 7x10x5 elements 3.9 x 1.9 x 0.028 m and a Coulomb plate of nu = 0.47:
   // the cold start's first step stopped its outer CG at the limit on S
   // products too inexact to converge and no length of it lowered |w|
@@ -338,7 +345,7 @@ TEST(TrescaDriver, ProblemsOfARandomSweepThatStagnatedConvergeWithAVerifiedAnswe
            "material": {"E": 1.383e8, "nu": 0.0004139},
            "loads": {"traction": {"z1": [-12430, 1087, -19530]}, "body_force": [0, 0, -626000]},
            "friction": {"tresca": 40.08}, "obstacle": {"kind": "cylinder", "radius": 1.503, "y": 0.2082, "gap": 0}})",
-       "a monotone line search"},
+       nullptr},
       {"first_step_redone",
        R"({"mesh": {"dims": [7, 10, 5]}, "box": {"lengths": [3.861, 1.945, 0.02812], "origin": [0, 0, 0]},
            "material": {"E": 1.15e8, "nu": 0.005871},
@@ -359,6 +366,7 @@ TEST(TrescaDriver, ProblemsOfARandomSweepThatStagnatedConvergeWithAVerifiedAnswe
            "friction": {"tresca": 120.6}, "obstacle": {"kind": "plane", "gap": 0, "slope": [0.0007987, 0.0002689]}})",
        nullptr}};
   for (const auto& c : cases) expect_verified_answer(c.name, c.json, c.note);
+  expect_verified_answer("cycling_block_on_w", cases[0].json, "a monotone line search", "--merit residual");
 }
 
 TEST(TrescaDriver, ProblemsWhoseEpsIsBelowWhatRResolvesConvergeToThatLevel) {
@@ -392,14 +400,40 @@ TEST(TrescaDriver, AStopTheFinalCheckDoesNotConfirmGoesOn) {
   // N <= eps, and the final check found a sliding node's friction direction
   // 1.4e-6 N off (kkt_check_failed). Newton now goes on from its own result
   // with eps lowered by the factor the check missed: one more step, and the
-  // check passes against the eps asked for (run.cpp: resume_after_check)
+  // check passes against the eps asked for (run.cpp: resume_after_check).
+  // (On |w| alone: the energy's envelope takes another path to a stop the
+  // check confirms, RESULTS.md §0zs)
   expect_verified_answer(
       "check_resumed",
       R"({"mesh": {"dims": [19, 7, 4]}, "box": {"lengths": [2.229, 0.1265, 0.133], "origin": [0, 0, 0]},
           "material": {"E": 31220000.0, "nu": -0.5081},
           "loads": {"traction": {"z1": [580.7, 2953.0, 5624.0], "x1": [-3100.0, -2111.0, 2908.0]}},
           "friction": {"tresca": 432.8}, "obstacle": {"kind": "plane", "gap": 1.857e-07, "slope": [0.0009628, 2.126e-05]}})",
-      "note: the final check did not confirm the stop after step");
+      "note: the final check did not confirm the stop after step", "--merit residual");
+}
+
+TEST(TrescaDriver, APlatePressedAndShearedOverAGapConvergesInAFewSteps) {
+  // perf/robustness_sweep.py --seed 7, problem 19 (RESULTS.md §0zs), rounded
+  // to 4 digits: a 25x4x7 plate pressed and sheared over a gap. On |w| alone
+  // the line search let Newton cycle through full steps that raised the
+  // energy, then creep at lengths 0.004-0.06: 50 steps, 2.2e6 N left
+  // (iteration_limit). With the forward-backward envelope as the merit far
+  // from the solution (NewtonOptions::envelope_merit) it converges in 7
+  const std::string file = ::testing::TempDir() + "/sheared_over_gap.json";
+  {
+    std::ofstream f(file);
+    f << R"({"mesh": {"dims": [25, 4, 7]}, "box": {"lengths": [2.948, 0.6684, 0.3602], "origin": [0, 0, 0]},
+            "material": {"E": 5.72e9, "nu": 0.2398},
+            "loads": {"traction": {"z1": [-1.704e6, 3.405e5, -3.848e6], "x1": [4.027e5, 3.644e5, -9.928e5]},
+                      "body_force": [0, 0, -1.182e6]},
+            "friction": {"tresca": 2.688e5},
+            "obstacle": {"kind": "plane", "gap": 9.898e-05, "slope": [0.0004939, 0.0003826]}})";
+  }
+  const CmdResult r = run("tresca --quiet --problem " + file);
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find(": ok\n"), std::string::npos) << r.out;  // the KKT check
+  EXPECT_GE(newton_steps(r.out), 1) << r.out;
+  EXPECT_LE(newton_steps(r.out), 12) << r.out;
 }
 
 TEST(TrescaDriver, WithoutLoadTheBodyStaysAtRest) {
@@ -481,8 +515,11 @@ TEST(TrescaDriver, ConvergesOverAMicrometreGapAndSaysHow) {
   // about 1e-4 m (semismooth.hpp: the line search's watchdog); a nested run
   // takes that step on its coarsest mesh, whose note the fine mesh's
   // report does not repeat
-  expect_run("tresca --dims 16x8x8 --gap 1e-6 --no-nested --quiet", 0,
+  // (on |w| alone; the energy's envelope falls along a short part of that
+  // step and takes it, RESULTS.md §0zs)
+  expect_run("tresca --dims 16x8x8 --gap 1e-6 --no-nested --quiet --merit residual", 0,
              "note: 1 Newton steps were taken whole where no step length decreased |w|");
+  expect_run("tresca --dims 16x8x8 --gap 1e-6 --no-nested --quiet", 0, "max uz -1.000000e-06");
   expect_run("tresca --level 6 --gap 1e-6 --quiet", 0, "max uz -1.000000e-06");
 }
 
