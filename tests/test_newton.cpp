@@ -399,8 +399,10 @@ TEST(SemismoothNewton, FallsThroughASmallGapAndReachesTheDenseSolution) {
     ASSERT_TRUE(R.converged()) << R.reason();
     if (envelope) {
       EXPECT_EQ(R.newton.watchdog_steps, 0);
+      EXPECT_GE(R.newton.envelope_steps, 1);  // (the first step's length at least)
       EXPECT_LT(R.newton.step_lengths.front(), 0.1);
     } else {
+      EXPECT_EQ(R.newton.envelope_steps, 0);
       EXPECT_EQ(R.newton.watchdog_steps, 1);
       EXPECT_EQ(R.newton.step_lengths.front(), 1.0);
       EXPECT_GT(R.newton.merit[1], 10 * R.newton.merit[0]);  // the step no length of which decreased |w|

@@ -292,6 +292,7 @@ void append_steps(NewtonResult& a, NewtonResult&& b) {
   a.operator_applications += b.operator_applications;
   a.outer_limit_hits += b.outer_limit_hits;
   a.watchdog_steps += b.watchdog_steps;
+  a.envelope_steps += b.envelope_steps;
   a.redone_steps += b.redone_steps;
   if (b.monotone_from >= 0) a.monotone_from = k0 + b.monotone_from;
   a.residual_floor = b.residual_floor;

@@ -417,20 +417,25 @@ void report_progress(const SteklovPoincare& S, const NewtonResult& R, const Poin
 // merit_at(alpha) <= (1 - 1e-4 alpha) times the largest of the last
 // memory + 1 merits (non-monotone, GLL); where the envelope rises at every
 // length (s below S's scale: not a descent direction), the first alpha by
-// |w| alone; 0 if there is none
-real line_search(const std::vector<real>& merits, int memory, int halvings, const std::function<real(real)>& merit_at,
-                 const std::function<std::optional<real>(real)>& envelope_at) {
+// |w| alone; 0 if there is none. by_envelope: the envelope chose alpha.
+struct StepLength {
+  real alpha = 0;
+  bool by_envelope = false;
+};
+StepLength line_search(const std::vector<real>& merits, int memory, int halvings,
+                       const std::function<real(real)>& merit_at,
+                       const std::function<std::optional<real>(real)>& envelope_at) {
   const int m = std::min<int>(memory + 1, int(merits.size()));
   const real reference = *std::max_element(merits.end() - m, merits.end());
   real alpha = 1;
   for (int j = 0; j <= halvings; ++j, alpha *= 0.5) {
     if (const std::optional<real> change = envelope_at ? envelope_at(alpha) : std::nullopt) {
-      if (*change < 0) return alpha;
+      if (*change < 0) return {alpha, true};
     } else if (merit_at(alpha) <= (1 - 1e-4 * alpha) * reference) {
-      return alpha;
+      return {alpha, false};
     }
   }
-  return envelope_at ? line_search(merits, memory, halvings, merit_at, {}) : 0;
+  return envelope_at ? line_search(merits, memory, halvings, merit_at, {}) : StepLength{};
 }
 
 // One semismooth* Newton solve (semismooth_newton): its state and its steps.
@@ -783,7 +788,7 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
   real alpha = 1;
   if (opt.line_search) {
     const int memory = R.monotone_from >= 0 ? 0 : opt.line_search_memory;
-    alpha = line_search(R.merit, memory, opt.line_search_halvings, [&](real a) {
+    const StepLength length = line_search(R.merit, memory, opt.line_search_halvings, [&](real a) {
       const real *u = x.u.data(), *r = x.r.data(), *lambda = x.lambda.data(), *dU = du.data(), *dl = dlambda.data();
       real *tu = trial.u.data(), *tr = trial.r.data(), *tl = trial.lambda.data();
       for_each_entry("line search trial", p, Cost{128, 14}, [=](index i) {
@@ -796,6 +801,8 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
       ScopedTimer t(Kernel::contact_maps, double(p) * kApproximationStepCost);
       return std::sqrt(S.sum(residual_at(trial).consistent));
     }, envelope_along_step(Sdu));
+    alpha = length.alpha;
+    R.envelope_steps += length.by_envelope;
     if (alpha == 0 && last_step_hit_limit && work.tightening > step_tightening && !redo) {
       // a step whose outer CG stopped at its limit on S products too inexact
       // to converge (check_step has just tightened the inner solves by the

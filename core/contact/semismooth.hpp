@@ -239,6 +239,7 @@ struct NewtonResult {
   long long outer_iterations = 0, inner_iterations = 0, operator_applications = 0;
   int outer_limit_hits = 0;      // Newton steps whose outer CG stopped at its iteration limit
   int watchdog_steps = 0;        // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
+  int envelope_steps = 0;        // steps whose length the energy's envelope chose (NewtonOptions::envelope_merit)
   int redone_steps = 0;          // steps solved again with tighter inner solves (their first stopped at the outer limit)
   int monotone_from = -1;        // the iteration from which the line search was monotone (-1: never; line_search)
   // > 0: converged at this floor of what r resolves [N], above eps: the

@@ -147,6 +147,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
                  {"newton_inner_iterations", N.inner_iterations},
                  {"outer_limit_hits", N.outer_limit_hits},
                  {"watchdog_steps", N.watchdog_steps},
+                 {"envelope_steps", N.envelope_steps},
                  {"redone_steps", N.redone_steps},
                  {"monotone_from", N.monotone_from},
                  {"resumed_from", R.resumed_from},

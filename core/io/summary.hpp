@@ -5,7 +5,7 @@
 // converged, reason, residual_history, final_residual, true_residual,
 // true_residual_relative, times {setup, condense, solve, recover, total},
 // counts {inner_iterations, outer_iterations, operator_applications,
-// newton_inner_iterations, outer_limit_hits, watchdog_steps, last_state_changes,
+// newton_inner_iterations, outer_limit_hits, watchdog_steps, envelope_steps, last_state_changes,
 // inner_tightening,
 // fine_matvecs_per_newton_step},
 // contact {active, separated, sticking, sliding, ux_min, uz_max, lambda_sum},
