@@ -124,6 +124,24 @@ TEST(Coulomb, NestedAndColdReachTheSameSolution) {
   EXPECT_TRUE(a.report.status == b.report.status);
 }
 
+TEST(Coulomb, TheFixedPointsTrescaSolvesKeepTheirFullSteps) {
+  // Coulomb 0.8 by the fixed point at level 4, nested from 40 contact
+  // nodes: each Tresca solve starts near its solution, where Newton's full
+  // steps cut |w| by orders of magnitude. The energy's envelope in the
+  // step's metric s (which need not bound S) can rise along such a step:
+  // taken as the only judge, it cut them to 2^-8 and the solve stagnated
+  // (RESULTS.md §0zs). A full step that halves |w| is taken before the
+  // envelope is asked: every step whole, the fixed point converged
+  RunOptions o;
+  o.friction = coulomb_friction(0.8, Method::fixed_point);
+  o.recover_interior = false;
+  o.nested_min_contact_nodes = 40;
+  const RunResult R = run_tresca(spec_for_level(4), o);
+  ASSERT_TRUE(R.converged()) << R.reason();
+  EXPECT_LE(R.newton_steps(), 30);
+  for (real alpha : R.newton.step_lengths) EXPECT_EQ(alpha, 1.0);
+}
+
 TEST(Coulomb, ReportsAnIterationLimitOfTheFixedPoint) {
   // one Tresca solve cannot make phi = F lambda consistent: not converged, and said so
   const Problem P = make_problem(spec_for_dims(8, 4, 4));

@@ -411,8 +411,12 @@ void report_progress(const SteklovPoincare& S, const NewtonResult& R, const Poin
   progress(pr);
 }
 
-// The backtracking line search: the first alpha = 2^-j, j = 0 .. halvings,
-// that lowers the forward-backward envelope where envelope_at(alpha)
+// The backtracking line search: with envelope_at, the full step where it
+// halves |w| (Newton's own convergence: the envelope in the metric s,
+// which need not bound S, can rise along a step that cuts |w| by orders of
+// magnitude, and a Coulomb fixed point's Tresca solves stagnated at
+// lengths 2^-8, RESULTS.md §0zs); else the first alpha = 2^-j, j = 0 ..
+// halvings, that lowers the forward-backward envelope where envelope_at(alpha)
 // resolves its change, and elsewhere (and without envelope_at) whose
 // merit_at(alpha) <= (1 - 1e-4 alpha) times the largest of the last
 // memory + 1 merits (non-monotone, GLL); where the envelope rises at every
@@ -427,6 +431,7 @@ StepLength line_search(const std::vector<real>& merits, int memory, int halvings
                        const std::function<std::optional<real>(real)>& envelope_at) {
   const int m = std::min<int>(memory + 1, int(merits.size()));
   const real reference = *std::max_element(merits.end() - m, merits.end());
+  if (envelope_at && merit_at(1) <= 0.5 * merits.back()) return {1, false};
   real alpha = 1;
   for (int j = 0; j <= halvings; ++j, alpha *= 0.5) {
     if (const std::optional<real> change = envelope_at ? envelope_at(alpha) : std::nullopt) {
