@@ -280,7 +280,7 @@ void parse_command(const Args& a, const Comm& comm, Command& c) {
   if (a.has("--coulomb-method") && !c.opt.friction.is_coulomb())
     c.no_effect.push_back("--coulomb-method chooses how Coulomb friction is solved; this run is Tresca (--coulomb F)");
   if (a.has("--no-nested") && table) c.no_effect.push_back("--no-nested: --table never nests (the paper's cold start)");
-  if (a.has("--merit") && (c.opt.newton.scaling != StepScaling::diagonal || c.opt.friction.bound_follows_lambda()))
+  if (a.has("--merit") && !envelope_applies(c.opt.newton.scaling, c.opt.friction))
     c.no_effect.push_back("--merit: the envelope is the merit of the scaled step (--scaling diagonal) with a bound that "
                           "does not follow lambda (Tresca, --coulomb-method fixed-point); this run uses |w| alone");
   c.quiet = a.has("--quiet");

@@ -849,7 +849,7 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
 // envelope's change is of the order of |w|² / s, it leaves the decision
 // to |w|.
 std::function<std::optional<real>(real)> NewtonSolve::envelope_along_step(const real* Sdu) {
-  if (!opt.envelope_merit || !scale_ptr || opt.friction.bound_follows_lambda()) return {};
+  if (!opt.envelope_merit || !envelope_applies(opt.scaling, opt.friction)) return {};
   const real* u = x.u.data();
   const real* r = x.r.data();
   const real* d = du.data();

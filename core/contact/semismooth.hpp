@@ -98,6 +98,13 @@ enum class StepScaling { paper, diagonal };
 // 1e4 N off); the paper's for --table only.
 enum class StopRule { consistent, paper };
 
+// Where the energy's envelope is a merit (NewtonOptions::envelope_merit):
+// the scaled step, with a bound that does not follow lambda (an energy is
+// minimised: Tresca, and Coulomb's fixed-point loop of Tresca solves)
+inline bool envelope_applies(StepScaling scaling, const FrictionLaw& friction) {
+  return scaling == StepScaling::diagonal && !friction.bound_follows_lambda();
+}
+
 // The scale of Newton's accuracies from the norm |b̃| [N] of the condensed
 // load: |b̃| itself, or 1 N where there is no load at all (b̃ = 0, whose
 // solution u = 0 any scale accepts).
