@@ -513,8 +513,8 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
                 "      Newton went on to eps %.1e, %d more steps\n",
                 R.resumed_from, R.resumed_eps, N.iterations - R.resumed_from);
   if (N.redone_steps > 0)
-    std::printf("note: %d Newton steps were solved again with tighter inner solves (the first solve stopped at the "
-                "outer CG's limit and no length of it lowered |w|)\n",
+    std::printf("note: %d Newton steps were solved again with tighter inner solves (a solve stopped at the outer "
+                "CG's limit short of its target, or its check found it worse than no step)\n",
                 N.redone_steps);
   if (N.monotone_from >= 0)
     std::printf("note: from Newton step %d on each step had to lower |w| (a monotone line search): the "

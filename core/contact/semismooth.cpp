@@ -462,7 +462,7 @@ class NewtonSolve {
   std::optional<NewtonReason> floor_stop(int k);
   std::optional<NewtonReason> newton_step();
   std::optional<NewtonReason> take_step();
-  void check_step(const real* Sdu, bool hit_limit);
+  bool check_step(const real* Sdu, bool hit_limit);
   std::function<std::optional<real>(real)> envelope_along_step(const real* Sdu);
 
   const SteklovPoincare& S;
@@ -490,9 +490,13 @@ class NewtonSolve {
   std::unique_ptr<BoundaryPreconditioner> M;
   CGWorkspace ws;
   real smax = 0;  // |S x| <= smax |x|
-  bool last_step_hit_limit = false;
+  bool last_step_hit_limit = false;  // this step's outer CG stopped at its limit (newton_step)
+  bool taken_at_limit = false;       // so did the last step taken
   real step_tightening = 1;  // the inner tightening when this step's solve began
-  bool redo = false;         // this iteration's step is being solved again (take_step)
+  bool redo = false;         // this iteration's step is to be solved again (take_step)
+  int redos = 0;             // times this iteration's step was solved again
+  static constexpr int kMaxRedos = 3;
+  static constexpr real kStallTightening = 10;  // the least a step stopped at the outer limit tightens by
   real step_rhs = 0, step_target = 0;  // the last step's |r_F| and accuracy asked (StepOutcome)
   real last_missed = 0;                // the factor the last step missed its accuracy by (check_step), 0: met
   int last_watchdog = std::numeric_limits<int>::min() / 2;  // the last step the watchdog took whole
@@ -676,6 +680,14 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
   for_each_entry("newton states kept", p, Cost{2, 0}, [=](index i) { before[i] = now[i]; });
   if (R.last_state_changes > 0) last_change = k;
   if (k >= opt.max_iterations) return NewtonReason::iteration_limit;
+  // after a restart from a fresh r (floor_stop), the r summed from the
+  // steps can fall again between the refreshes that put |w| back at the
+  // fresh level, which the window test counts as progress: the floor is
+  // judged again once a window has passed since the restart (a plate of
+  // elements 24:1 alternated between 5e-6 and 6e-4 N to the iteration
+  // limit, RESULTS.md §0zt)
+  if (window_from > 0 && k - window_from >= opt.stagnation_window)
+    if (const auto stop = floor_stop(k)) return stop;
   const bool progress = R.last_state_changes > 0 && R.merit[k] < R.merit[k - 1];
   auto stagnating = [&] { return stagnated(R.merit, opt.stagnation_window, std::max(R.monotone_from, window_from)); };
   if (!progress && stagnating()) {
@@ -751,8 +763,9 @@ std::optional<NewtonReason> NewtonSolve::newton_step() {
   if (step.outer.reason == SolveReason::non_finite) return NewtonReason::non_finite;
   if (step.outer.reason == SolveReason::breakdown) return NewtonReason::outer_failure;
   const bool limit = step.outer.reason == SolveReason::max_iterations;
-  if (limit) R.outer_limit_hits += 1;  // inexact step taken
-  if (limit && last_step_hit_limit) return NewtonReason::outer_failure;
+  // (a step at the limit is solved again, take_step; after a step taken at
+  // the limit, one whose last redo stops there too ends Newton)
+  if (limit && taken_at_limit && redos >= kMaxRedos) return NewtonReason::outer_failure;
   last_step_hit_limit = limit;
   return std::nullopt;
 }
@@ -778,7 +791,16 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
   R.operator_applications += 1;
   if (!work.apply(S, du.data(), Sdu, inc_rtol, Edu, Edu)) return NewtonReason::inner_failure;
   r_err = std::max(r_err, accuracy);
-  check_step(Sdu, last_step_hit_limit);  // (this step's: newton_step sets it)
+  // a step check_step finds unfit (worse than none, or stopped at the outer
+  // limit short of its target), and has tightened the inner solves for:
+  // solved again from the same x, at most kMaxRedos times an iteration
+  const bool unfit = check_step(Sdu, last_step_hit_limit);
+  if (unfit && work.tightening > step_tightening && redos < kMaxRedos) {
+    redo = true;
+    redos += 1;
+    R.redone_steps += 1;
+    return std::nullopt;
+  }
   // (the launches' bodies take copies of members, not `this`: a body that
   // read p through it read host memory on a GPU, RESULTS.md §0zf)
   const index np = p;
@@ -808,19 +830,6 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
     }, envelope_along_step(Sdu));
     alpha = length.alpha;
     R.envelope_steps += length.by_envelope;
-    if (alpha == 0 && last_step_hit_limit && work.tightening > step_tightening && !redo) {
-      // a step whose outer CG stopped at its limit on S products too inexact
-      // to converge (check_step has just tightened the inner solves by the
-      // factor it fell short) and no length of which lowers |w|: solved
-      // again from the same x with the tighter inner solves, once. A cold
-      // start on a thin plate (e.g. 36x6x3 elements, 1 x 0.33 x 0.029 m)
-      // ended there in stagnation, after 2000 outer iterations as after 200
-      // (RESULTS.md §0zq); a second stop at the limit ends Newton
-      // (newton_step: outer_failure).
-      redo = true;
-      R.redone_steps += 1;
-      return std::nullopt;
-    }
     if (alpha == 0) {
       // the watchdog (NewtonOptions::line_search): a step solved to its
       // tolerance is taken whole, once in line_search_memory + 1 steps
@@ -832,6 +841,8 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
     }
   }
   R.step_lengths.push_back(alpha);
+  taken_at_limit = last_step_hit_limit;
+  R.outer_limit_hits += taken_at_limit;  // (an inexact step taken)
   axpy(p, alpha, dlambda.data(), x.lambda.data());
   axpy(n3, alpha, du.data(), x.u.data());
   axpy(n3, alpha, Sdu, x.r.data());
@@ -882,14 +893,19 @@ std::function<std::optional<real>(real)> NewtonSolve::envelope_along_step(const 
 // alone may be the step's own: a cold start's free fall over a gap leaves
 // 0.2 r_F with ν = 0.45, and the next step meets its target.) A step whose
 // outer CG stopped at its iteration limit short of its target tightens at
-// once, by the factor it fell short by, even where it removed 90 % of r_F:
-// CG lost its way on S products too inexact to converge, and a second such
-// step in a row would end Newton (outer_failure) before a second miss
-// could tighten (a plate 2 x 1 x 0.0125 m of 32x16x4 elements did,
-// RESULTS.md §0zl; plates 2 x 1 x 0.0098-0.0101 m of 64x32x4 elements
-// after steps that removed 99 % of r_F, §0zp). The steps of ordinary runs
-// never miss twice in a row, never stop at the limit, and never tighten.
-void NewtonSolve::check_step(const real* Sdu, bool hit_limit) {
+// once, by the factor it fell short by and at least kStallTightening, even
+// where it removed 90 % of r_F: CG lost its way on S products too inexact
+// to converge (a plate 2 x 1 x 0.0125 m of 32x16x4 elements, RESULTS.md
+// §0zl; plates 2 x 1 x 0.0098-0.0101 m of 64x32x4 elements after steps
+// that removed 99 % of r_F, §0zp; elements 20-750 times longer than wide
+// stopped there step after step, by 1.5-200 times their targets, §0zt).
+// So does a step left worse than none, by the factor it missed its target
+// by (its residual above r_F itself: 1.3 r_F, 129 times its target, on an
+// auxetic plate lifted off a sphere, §0zt). Both are unfit: true,
+// and take_step solves them again. The steps of ordinary runs never miss
+// twice in a row, never stop at the limit, are never worse than none, and
+// never tighten.
+bool NewtonSolve::check_step(const real* Sdu, bool hit_limit) {
   const ReducedSystem::View V = L.view();
   const real *dU = du.data(), *Sk = L.known_product.data(), *rhs = L.rhs.data();
   const index np = p;
@@ -903,9 +919,13 @@ void NewtonSolve::check_step(const real* Sdu, bool hit_limit) {
   // (a factor > 1 where the step left more than a tenth of r_F, else 0)
   const real factor =
       missed > std::max(real(0.1) * step_rhs, step_target) && step_target > 0 ? missed / step_target : 0;
-  // (a step stopped at the limit: the factor by which it fell short of its target)
-  const real short_by = hit_limit && missed > step_target && step_target > 0 ? missed / step_target : 0;
-  const real by = std::max(last_missed > 0 ? std::min(factor, last_missed) : real(0), short_by);
+  // (a step stopped at the limit: the factor by which it fell short of its
+  // target, at least kStallTightening)
+  const real short_by =
+      hit_limit && missed > step_target && step_target > 0 ? std::max(missed / step_target, kStallTightening) : 0;
+  // (a step whose residual exceeds r_F itself: worse than no step at all)
+  const bool worse = factor > 0 && missed > step_rhs;
+  const real by = std::max({last_missed > 0 ? std::min(factor, last_missed) : real(0), short_by, worse ? factor : 0});
   if (by > 0) {
     const real tighter = std::min(work.tightening * by, real(1e8));
     // r's increments so far were that much less accurate than counted: its
@@ -914,6 +934,7 @@ void NewtonSolve::check_step(const real* Sdu, bool hit_limit) {
     work.tightening = tighter;
   }
   last_missed = factor;
+  return worse || short_by > 0;
 }
 
 NewtonResult NewtonSolve::run() {
@@ -921,12 +942,13 @@ NewtonResult NewtonSolve::run() {
   for (int k = 0;; ++k) {
     if (!measure(k)) return finish(NewtonReason::inner_failure);
     if (const auto stop = record(k)) return finish(*stop);
-    redo = false;
-    do {  // (once more where take_step asks to redo the step: x is unchanged)
+    redos = 0;
+    do {  // (again where take_step asks to redo the step: x is unchanged)
+      redo = false;
       step_tightening = work.tightening;
       if (const auto failed = newton_step()) return finish(*failed);
       if (const auto failed = take_step()) return finish(*failed);
-    } while (redo && R.step_lengths.size() == size_t(k));
+    } while (redo);
     R.iterations = k + 1;
   }
 }

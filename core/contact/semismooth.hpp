@@ -60,7 +60,8 @@
 namespace tresca {
 
 // outer_failure: two Newton steps in a row whose boundary CG stopped at its
-// iteration limit (the step systems are not being solved: e.g. nearly
+// iteration limit, the second also when solved again 3 times with tighter
+// inner solves (the step systems are not being solved: e.g. nearly
 // incompressible material, where it used to grind on for minutes), or a
 // boundary Krylov solve that broke down (a direction of zero or negative
 // curvature: the step's operator or its preconditioner not positive);
@@ -249,7 +250,7 @@ struct NewtonResult {
   int outer_limit_hits = 0;      // Newton steps whose outer CG stopped at its iteration limit
   int watchdog_steps = 0;        // steps taken whole where no length decreased |w| (NewtonOptions::line_search)
   int envelope_steps = 0;        // steps whose length the energy's envelope chose (NewtonOptions::envelope_merit)
-  int redone_steps = 0;          // steps solved again with tighter inner solves (their first stopped at the outer limit)
+  int redone_steps = 0;          // steps solved again with tighter inner solves (NewtonSolve::take_step: unfit)
   int monotone_from = -1;        // the iteration from which the line search was monotone (-1: never; line_search)
   // > 0: converged at this floor of what r resolves [N], above eps: the
   // level |w| stayed at (NewtonOptions::floor_rtol); tolerance is then it
