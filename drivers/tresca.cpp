@@ -473,13 +473,17 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
     std::printf("note: |v| stagnated at %.1e of its initial value, the accuracy the inner solves attain: eps = %.1e\n"
                 "      is out of reach for this problem's magnitudes (--eps %.0e would be met)\n",
                 N.history.back() / N.history.front(), eps, std::pow(10.0, std::ceil(std::log10(2 * N.history.back()))));
-  if (N.residual_floor > 0)
+  if (N.residual_floor > 0) {
     std::printf("note: eps = %.1e N is finer than r = S u - b~ resolves for this problem: |v| stayed at or below\n"
                 "      %.1e N (%.1e |b~|) for %d Newton steps with no contact state changed; converged to that\n"
                 "      level, confirmed with a fresh r (--eps %.0e asks for no more)\n",
                 eps, N.residual_floor, N.residual_floor / F.btilde_norm, c.opt.newton.stagnation_window,
                 std::pow(10.0, std::ceil(std::log10(N.residual_floor))));
-  else if (N.converged() && !(F.true_residual <= eps))
+    if (N.floor_measured > 0)
+      std::printf("note: that level is above 1e-10 |b~|: two fresh r at x, one warm and one from a cold start, differed\n"
+                  "      by %.1e N (%.1e |b~|), what r resolves here (a small difference of large terms)\n",
+                  N.floor_measured, N.floor_measured / F.btilde_norm);
+  } else if (N.converged() && !(F.true_residual <= eps))
     std::printf("note: the true residual is above eps = %.1e = %.1e |b|, finer than the inner solves resolve (~1e-12 |b|)\n",
                 eps, eps / F.btilde_norm);
   else if (N.converged() && F.resolution > eps)

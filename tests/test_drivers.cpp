@@ -399,6 +399,32 @@ TEST(TrescaDriver, ProblemsWhoseEpsIsBelowWhatRResolvesConvergeToThatLevel) {
   for (const auto& c : cases) expect_verified_answer(c.name, c.json, "is finer than r = S u - b~ resolves");
 }
 
+TEST(TrescaDriver, ProblemsWhoseRResolvesLessThan1e10OfBConvergeToTheLevelMeasured) {
+  // Drawn by perf/robustness_sweep.py --seeds 13 and 2 (RESULTS.md §0zt),
+  // rounded to 4 digits: a 15x2x7 plate (elements 30:1) on a plane and a
+  // 7x7x6 plate (elements 108:1). Each fresh r alternated with Newton's
+  // steps at 1.9e-9 and 6e-10 |b~|, the contact states settled, above the
+  // 1e-10 |b~| a floor was allowed: stagnation after 31 and 29 steps. A
+  // fresh r from a cold start now measures what r resolves there (it
+  // differed from the warm one by 1e-6 |b~|), and each converges to the
+  // level it stayed at, with the final KKT check at that level
+  // (semismooth.cpp: floor_cap).
+  const struct {
+    const char* name;
+    const char* json;
+  } cases[] = {
+      {"measured_floor_plane",
+       R"({"mesh": {"dims": [15, 2, 7]}, "box": {"lengths": [4.21, 0.4645, 0.09347], "origin": [0, 0, 0]},
+           "material": {"E": 197700000.0, "nu": 0.4684}, "loads": {"traction": {"z1": [-12320.0, 12900.0, 16000.0]}},
+           "friction": {"tresca": 1079.0}, "obstacle": {"kind": "plane", "gap": 1.159e-05, "slope": [0.0006, 0.000529]}})"},
+      {"measured_floor_thin",
+       R"({"mesh": {"dims": [7, 7, 6]}, "box": {"lengths": [3.65, 0.2569, 0.02895], "origin": [0, 0, 0]},
+           "material": {"E": 552600000.0, "nu": -0.09299},
+           "loads": {"traction": {"z1": [46400.0, -34960.0, 150400.0], "x1": [165900.0, -55710.0, 53580.0]}},
+           "friction": {"tresca": 816.3}, "obstacle": {"kind": "plane", "gap": 0, "slope": [0.0006703, 0.0004091]}})"}};
+  for (const auto& c : cases) expect_verified_answer(c.name, c.json, "that level is above 1e-10 |b~|");
+}
+
 TEST(TrescaDriver, AStopTheFinalCheckDoesNotConfirmGoesOn) {
   // perf/robustness_sweep.py --seed 11, problem 56 (RESULTS.md §0zt),
   // rounded to 4 digits: a 23x9x6 block pressed and sheared on a plane stops

@@ -296,6 +296,7 @@ void append_steps(NewtonResult& a, NewtonResult&& b) {
   a.redone_steps += b.redone_steps;
   if (b.monotone_from >= 0) a.monotone_from = k0 + b.monotone_from;
   a.residual_floor = b.residual_floor;
+  a.floor_measured = b.floor_measured;
   a.tolerance = std::max(a.tolerance, b.residual_floor);
   a.last_state_changes = b.last_state_changes;
   a.inner_tightening = b.inner_tightening;

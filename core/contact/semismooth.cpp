@@ -460,6 +460,7 @@ class NewtonSolve {
   bool measure(int k);
   std::optional<NewtonReason> record(int k);
   std::optional<NewtonReason> floor_stop(int k);
+  real floor_cap(real level);
   std::optional<NewtonReason> newton_step();
   std::optional<NewtonReason> take_step();
   bool check_step(const real* Sdu, bool hit_limit);
@@ -497,6 +498,7 @@ class NewtonSolve {
   int redos = 0;             // times this iteration's step was solved again
   static constexpr int kMaxRedos = 3;
   static constexpr real kStallTightening = 10;  // the least a step stopped at the outer limit tightens by
+  static constexpr real kMeasuredFloorMax = 1e-8;  // relative to |b̃|: floor_cap
   real step_rhs = 0, step_target = 0;  // the last step's |r_F| and accuracy asked (StepOutcome)
   real last_missed = 0;                // the factor the last step missed its accuracy by (check_step), 0: met
   int last_watchdog = std::numeric_limits<int>::min() / 2;  // the last step the watchdog took whole
@@ -725,7 +727,7 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
 std::optional<NewtonReason> NewtonSolve::floor_stop(int k) {
   const int w = opt.stagnation_window;
   if (k - last_change < w || opt.floor_rtol <= 0 || opt.stop != StopRule::consistent ||
-      *std::min_element(R.merit.end() - w, R.merit.end()) > opt.floor_rtol * fscale)
+      *std::min_element(R.merit.end() - w, R.merit.end()) > std::max(opt.floor_rtol, kMeasuredFloorMax) * fscale)
     return std::nullopt;
   real level = std::max(*std::max_element(R.merit.end() - w, R.merit.end()), resolved());
   const real summed = merit;
@@ -740,13 +742,41 @@ std::optional<NewtonReason> NewtonSolve::floor_stop(int k) {
     const real restart_merit = R.merit[size_t(window_from)];  // (the fresh r's |w| there)
     if (merit > 0.5 * restart_merit) level = std::max({level, merit, restart_merit});
   }
-  if (merit <= level && level <= opt.floor_rtol * fscale) {
+  if (merit <= level && level <= floor_cap(level)) {
     R.residual_floor = level;
     R.tolerance = level;
     return NewtonReason::converged;
   }
   if (merit > 2 * summed && merit > resolved() && window_from == 0) window_from = k;
   return std::nullopt;
+}
+
+// The largest level floor_stop calls the floor of what r resolves:
+// floor_rtol |b̃|, and above it (up to kMeasuredFloorMax |b̃|) what a fresh r
+// resolves at x as measured: the difference between the fresh r (warm from
+// the body) and a second one solved from a cold start to the same
+// tolerance, which is relative to the interior load (the warm one is often
+// better than that: the difference bounds it from above). Where S is a
+// small difference of large terms (thin plates: an interior load 1.5e4
+// |b̃|), a fresh r at the tightest inner tolerance is exact only to
+// 1e-10-1e-9 |b̃|, and Newton's steps, each cancelling the last fresh r's
+// error, leave the next one's at that level: stagnation at 1.5e-10 to
+// 3.8e-9 |b̃| on elements 11-108:1, where the two fresh r differed by
+// 1.5e-9 to 1.3e-5 |b̃| (RESULTS.md §0zt).
+real NewtonSolve::floor_cap(real level) {
+  const real cap = opt.floor_rtol * fscale;
+  if (level <= cap || level > kMeasuredFloorMax * fscale) return cap;
+  real* cold = trial.r.data();
+  real* body = side.data() + n3;  // (the step's E Δu: scratch until the next step)
+  R.operator_applications += 1;
+  if (!work.residual(S, x.u.data(), cold, 1e-12, body, nullptr)) return cap;
+  const real* r = x.r.data();
+  const real resolves = std::sqrt(S.sum(sum_over_entries("newton floor measured", n3, Cost{16, 3}, [=](index i) {
+    const real d = r[i] - cold[i];
+    return d * d;
+  })));
+  R.floor_measured = resolves;
+  return std::max(cap, resolves);
 }
 
 // 2. linearisation: known increments, free set, H, right-hand side, and

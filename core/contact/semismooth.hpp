@@ -255,6 +255,9 @@ struct NewtonResult {
   // > 0: converged at this floor of what r resolves [N], above eps: the
   // level |w| stayed at (NewtonOptions::floor_rtol); tolerance is then it
   real residual_floor = 0;
+  // > 0: what r resolved at the iterate as measured (two fresh r, warm and
+  // cold, differed by this [N]) where the floor was above floor_rtol |b̃|
+  real floor_measured = 0;
   index last_state_changes = 0;  // nodes whose contact or stick state the last step changed (all ranks)
   // the factor (>= 1) by which the steps' inner tolerances were tightened
   // where two steps in a row, checked with a fresh S Δu, missed their accuracy

@@ -93,6 +93,7 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["stopping_rule"] = N.stop == StopRule::consistent ? "consistent" : "paper";
   j["tolerance"] = N.tolerance;
   j["residual_floor"] = N.residual_floor;  // > 0: converged at this level of what r resolves, above eps [N]
+  j["floor_measured"] = N.floor_measured;  // > 0: |r warm - r cold| there, where the floor was above 1e-10 |b~| [N]
   j["residual_history"] = N.history;
   j["step_lengths"] = N.step_lengths;
   j["inner_iterations_history"] = N.inner_history;
