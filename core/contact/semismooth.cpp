@@ -431,12 +431,15 @@ StepLength line_search(const std::vector<real>& merits, int memory, int halvings
                        const std::function<std::optional<real>(real)>& envelope_at) {
   const int m = std::min<int>(memory + 1, int(merits.size()));
   const real reference = *std::max_element(merits.end() - m, merits.end());
-  if (envelope_at && merit_at(1) <= 0.5 * merits.back()) return {1, false};
+  // (the full step's merit, asked once)
+  std::optional<real> full;
+  auto merit = [&](real alpha) { return alpha == 1 ? (full ? *full : *(full = merit_at(1))) : merit_at(alpha); };
+  if (envelope_at && merit(1) <= 0.5 * merits.back()) return {1, false};
   real alpha = 1;
   for (int j = 0; j <= halvings; ++j, alpha *= 0.5) {
     if (const std::optional<real> change = envelope_at ? envelope_at(alpha) : std::nullopt) {
       if (*change < 0) return {alpha, true};
-    } else if (merit_at(alpha) <= (1 - 1e-4 * alpha) * reference) {
+    } else if (merit(alpha) <= (1 - 1e-4 * alpha) * reference) {
       return {alpha, false};
     }
   }
@@ -894,10 +897,22 @@ std::function<std::optional<real>(real)> NewtonSolve::envelope_along_step(const 
   const real* u = x.u.data();
   const real* r = x.r.data();
   const real* d = du.data();
-  const real dr = S.sum(dot(n3, d, r)), dsd = S.sum(dot(n3, d, Sdu));
-  const real cross = std::sqrt(S.sum(dot(n3, d, d)) * S.sum(dot(n3, r, r)));
+  // du·r, du·S du and |du||r|, at the first length asked (a full step that
+  // halves |w| asks none)
+  struct Dots {
+    bool made = false;
+    real dr = 0, dsd = 0, cross = 0;
+  };
+  auto dots = std::make_shared<Dots>();
   const ContactLaw law{x.phi.data(), gap.data(), opt.kink_contact};
   return [=](real a) -> std::optional<real> {
+    if (!dots->made) {
+      dots->dr = S.sum(dot(n3, d, r));
+      dots->dsd = S.sum(dot(n3, d, Sdu));
+      dots->cross = std::sqrt(S.sum(dot(n3, d, d)) * S.sum(dot(n3, r, r)));
+      dots->made = true;
+    }
+    const real dr = dots->dr, dsd = dots->dsd, cross = dots->cross;
     ScopedTimer t(Kernel::contact_maps, 2 * double(p) * kEnvelopeChangeCost);
     const EnvelopeChange e = envelope_change(p, law, scale_ptr, a, u, r, d, Sdu);
     const real change = a * dr + real(0.5) * a * a * dsd + S.sum(e.change);
