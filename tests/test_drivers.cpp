@@ -69,6 +69,12 @@ void expect_run(const std::string& args, int status, const std::string& says, co
 // `tresca --quiet --problem` on a problem file of these contents (and
 // `options`): a run that converged with a verified answer (the KKT check
 // ok) and says `note`; its output
+// a problem file's contents and the name its test writes it under
+struct NamedProblem {
+  const char* name;
+  const char* json;
+};
+
 std::string expect_verified_answer(const std::string& name, const std::string& json, const char* note = nullptr,
                                    const std::string& options = "") {
   const std::string file = ::testing::TempDir() + "/" + name + ".json";
@@ -312,10 +318,7 @@ TEST(TrescaDriver, ThinPlatesWhoseStepsAreInexactConvergeWithAVerifiedAnswer) {
   // removing 99 % of r_F (not a miss), so nothing tightened and Newton ended
   // with outer_solver_failure; a step stopped at the limit short of its
   // target now tightens by the factor it fell short by (RESULTS.md §0zp).
-  const struct {
-    const char* name;
-    const char* json;
-  } plates[] = {{"thin_plate_0125", R"({"mesh": {"dims": [32, 16, 4]}, "box": {"lengths": [2, 1, 0.0125]}})"},
+  const NamedProblem plates[] = {{"thin_plate_0125", R"({"mesh": {"dims": [32, 16, 4]}, "box": {"lengths": [2, 1, 0.0125]}})"},
                 {"thin_plate_64", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.01]}})"},
                 {"thin_plate_64_0099", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.0099]}})"},
                 {"thin_plate_64_0101", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.0101]}})"}};
@@ -382,10 +385,7 @@ TEST(TrescaDriver, ProblemsWhoseEpsIsBelowWhatRResolvesConvergeToThatLevel) {
   // between the summed r's 5e-6 N and the fresh r's 6e-4 N to the
   // iteration limit; the floor is now judged again a window after the
   // restart: RESULTS.md §0zt)
-  const struct {
-    const char* name;
-    const char* json;
-  } cases[] = {
+  const NamedProblem cases[] = {
       {"floor_bar",
        R"({"mesh": {"dims": [35, 1, 4]}, "box": {"lengths": [4.27, 0.603, 0.03929], "origin": [0, 0, 0]},
            "material": {"E": 1816000000.0, "nu": -0.1659},
@@ -409,10 +409,7 @@ TEST(TrescaDriver, ProblemsWhoseRResolvesLessThan1e10OfBConvergeToTheLevelMeasur
   // differed from the warm one by 1e-6 |b~|), and each converges to the
   // level it stayed at, with the final KKT check at that level
   // (semismooth.cpp: floor_cap).
-  const struct {
-    const char* name;
-    const char* json;
-  } cases[] = {
+  const NamedProblem cases[] = {
       {"measured_floor_plane",
        R"({"mesh": {"dims": [15, 2, 7]}, "box": {"lengths": [4.21, 0.4645, 0.09347], "origin": [0, 0, 0]},
            "material": {"E": 197700000.0, "nu": 0.4684}, "loads": {"traction": {"z1": [-12320.0, 12900.0, 16000.0]}},
@@ -576,10 +573,7 @@ TEST(TrescaDriver, StepsSolvedWithTooInexactSProductsAreSolvedAgain) {
   // and each ended outer_solver_failure; a step stopped at the limit is now
   // solved again with the inner solves tightened at least 10x, up to 3
   // times. Rounded to 4 digits.
-  const struct {
-    const char* name;
-    const char* json;
-  } limit_cases[] = {
+  const NamedProblem limit_cases[] = {
       {"limit_plane",
        R"({"mesh": {"dims": [2, 4, 7]}, "box": {"lengths": [3.909, 2.251, 0.06201], "origin": [0, 0, 0]},
            "material": {"E": 9408000.0, "nu": 0.3352},
