@@ -318,10 +318,11 @@ TEST(TrescaDriver, ThinPlatesWhoseStepsAreInexactConvergeWithAVerifiedAnswer) {
   // removing 99 % of r_F (not a miss), so nothing tightened and Newton ended
   // with outer_solver_failure; a step stopped at the limit short of its
   // target now tightens by the factor it fell short by (RESULTS.md §0zp).
-  const NamedProblem plates[] = {{"thin_plate_0125", R"({"mesh": {"dims": [32, 16, 4]}, "box": {"lengths": [2, 1, 0.0125]}})"},
-                {"thin_plate_64", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.01]}})"},
-                {"thin_plate_64_0099", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.0099]}})"},
-                {"thin_plate_64_0101", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.0101]}})"}};
+  const NamedProblem plates[] = {
+      {"thin_plate_0125", R"({"mesh": {"dims": [32, 16, 4]}, "box": {"lengths": [2, 1, 0.0125]}})"},
+      {"thin_plate_64", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.01]}})"},
+      {"thin_plate_64_0099", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.0099]}})"},
+      {"thin_plate_64_0101", R"({"mesh": {"dims": [64, 32, 4]}, "box": {"lengths": [2, 1, 0.0101]}})"}};
   for (const auto& plate : plates)
     expect_verified_answer(plate.name, plate.json, "note: the Newton steps' inner solves were tightened");
 }
