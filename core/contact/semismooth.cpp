@@ -463,7 +463,7 @@ class NewtonSolve {
   bool measure(int k);
   std::optional<NewtonReason> record(int k);
   std::optional<NewtonReason> floor_stop(int k);
-  real floor_cap(real level);
+  real floor_cap(real level, real& measured);
   std::optional<NewtonReason> newton_step();
   std::optional<NewtonReason> take_step();
   bool check_step(const real* Sdu, bool hit_limit);
@@ -745,8 +745,10 @@ std::optional<NewtonReason> NewtonSolve::floor_stop(int k) {
     const real restart_merit = R.merit[size_t(window_from)];  // (the fresh r's |w| there)
     if (merit > 0.5 * restart_merit) level = std::max({level, merit, restart_merit});
   }
-  if (merit <= level && level <= floor_cap(level)) {
+  real measured = 0;  // (what r resolves, where floor_cap measured it)
+  if (merit <= level && level <= floor_cap(level, measured)) {
     R.residual_floor = level;
+    R.floor_measured = measured;
     R.tolerance = level;
     return NewtonReason::converged;
   }
@@ -766,7 +768,7 @@ std::optional<NewtonReason> NewtonSolve::floor_stop(int k) {
 // error, leave the next one's at that level: stagnation at 1.5e-10 to
 // 3.8e-9 |b̃| on elements 11-108:1, where the two fresh r differed by
 // 1.5e-9 to 1.3e-5 |b̃| (RESULTS.md §0zt).
-real NewtonSolve::floor_cap(real level) {
+real NewtonSolve::floor_cap(real level, real& measured) {
   const real cap = opt.floor_rtol * fscale;
   if (level <= cap || level > kMeasuredFloorMax * fscale) return cap;
   real* cold = trial.r.data();
@@ -778,7 +780,7 @@ real NewtonSolve::floor_cap(real level) {
     const real d = r[i] - cold[i];
     return d * d;
   })));
-  R.floor_measured = resolves;
+  measured = resolves;
   return std::max(cap, resolves);
 }
 
