@@ -690,13 +690,15 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
   // fresh level, which the window test counts as progress: the floor is
   // judged again once a window has passed since the restart (a plate of
   // elements 24:1 alternated between 5e-6 and 6e-4 N to the iteration
-  // limit, RESULTS.md §0zt)
-  if (window_from > 0 && k - window_from >= opt.stagnation_window)
+  // limit, RESULTS.md §0zt); once an iteration
+  const bool judged = window_from > 0 && k - window_from >= opt.stagnation_window;
+  if (judged)
     if (const auto stop = floor_stop(k)) return stop;
   const bool progress = R.last_state_changes > 0 && R.merit[k] < R.merit[k - 1];
   auto stagnating = [&] { return stagnated(R.merit, opt.stagnation_window, std::max(R.monotone_from, window_from)); };
   if (!progress && stagnating()) {
-    if (const auto stop = floor_stop(k)) return stop;
+    if (!judged)
+      if (const auto stop = floor_stop(k)) return stop;
     if (!stagnating()) return std::nullopt;  // (r refreshed: the window starts again)
     // the non-monotone search let Newton wander (NewtonOptions::line_search):
     // from here on each step must lower |w|, and stagnation is judged anew;
@@ -775,13 +777,9 @@ real NewtonSolve::floor_cap(real level, real& measured) {
   real* body = side.data() + n3;  // (the step's E Δu: scratch until the next step)
   R.operator_applications += 1;
   if (!work.residual(S, x.u.data(), cold, 1e-12, body, nullptr)) return cap;
-  const real* r = x.r.data();
-  const real resolves = std::sqrt(S.sum(sum_over_entries("newton floor measured", n3, Cost{16, 3}, [=](index i) {
-    const real d = r[i] - cold[i];
-    return d * d;
-  })));
-  measured = resolves;
-  return std::max(cap, resolves);
+  axpy(n3, -1, x.r.data(), cold);
+  measured = std::sqrt(S.sum(dot(n3, cold, cold)));
+  return std::max(cap, measured);
 }
 
 // 2. linearisation: known increments, free set, H, right-hand side, and
@@ -899,22 +897,13 @@ std::function<std::optional<real>(real)> NewtonSolve::envelope_along_step(const 
   const real* u = x.u.data();
   const real* r = x.r.data();
   const real* d = du.data();
-  // du·r, du·S du and |du||r|, at the first length asked (a full step that
-  // halves |w| asks none)
-  struct Dots {
-    bool made = false;
-    real dr = 0, dsd = 0, cross = 0;
-  };
-  auto dots = std::make_shared<Dots>();
   const ContactLaw law{x.phi.data(), gap.data(), opt.kink_contact};
-  return [=](real a) -> std::optional<real> {
-    if (!dots->made) {
-      dots->dr = S.sum(dot(n3, d, r));
-      dots->dsd = S.sum(dot(n3, d, Sdu));
-      dots->cross = std::sqrt(S.sum(dot(n3, d, d)) * S.sum(dot(n3, r, r)));
-      dots->made = true;
-    }
-    const real dr = dots->dr, dsd = dots->dsd, cross = dots->cross;
+  // (du·r, du·S du and |du||r|, at the first length asked: a full step that
+  // halves |w| asks none)
+  return [=, dots = std::optional<std::array<real, 3>>()](real a) mutable -> std::optional<real> {
+    if (!dots)
+      dots = {S.sum(dot(n3, d, r)), S.sum(dot(n3, d, Sdu)), std::sqrt(S.sum(dot(n3, d, d)) * S.sum(dot(n3, r, r)))};
+    const auto [dr, dsd, cross] = *dots;
     ScopedTimer t(Kernel::contact_maps, 2 * double(p) * kEnvelopeChangeCost);
     const EnvelopeChange e = envelope_change(p, law, scale_ptr, a, u, r, d, Sdu);
     const real change = a * dr + real(0.5) * a * a * dsd + S.sum(e.change);
