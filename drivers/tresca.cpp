@@ -481,7 +481,8 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
                 std::pow(10.0, std::ceil(std::log10(N.residual_floor))));
     if (N.floor_measured > 0)
       std::printf("note: that level is above 1e-10 |b~|: two fresh r at x, one warm and one from a cold start, differed\n"
-                  "      by %.1e N (%.1e |b~|), what r resolves here (a small difference of large terms)\n",
+                  "      by %.1e N (%.1e |b~|), what r resolves here (a small difference of large terms); the level\n"
+                  "      is within 4 times that, the spread of a fresh r's error\n",
                   N.floor_measured, N.floor_measured / F.btilde_norm);
   } else if (N.converged() && !(F.true_residual <= eps))
     std::printf("note: the true residual is above eps = %.1e = %.1e |b|, finer than the inner solves resolve (~1e-12 |b|)\n",

@@ -409,8 +409,19 @@ TEST(TrescaDriver, ProblemsWhoseRResolvesLessThan1e10OfBConvergeToTheLevelMeasur
   // fresh r from a cold start now measures what r resolves there (it
   // differed from the warm one by 1e-6 |b~|), and each converges to the
   // level it stayed at, with the final KKT check at that level
-  // (semismooth.cpp: floor_cap).
+  // (semismooth.cpp: floor_cap). And a 20x18x3 block (elements 41:1,
+  // nu = 0.487, seed 37), whose fresh r put |w| at 0.04-0.17 N over a
+  // window where two fresh r differed by 0.065 N (tighter inner solves
+  // lowered neither: the arithmetic's limit): the level is compared with 4
+  // times the measurement, the spread of a fresh r's error (RESULTS.md
+  // §0zu).
   const NamedProblem cases[] = {
+      {"measured_floor_block",
+       R"({"mesh": {"dims": [20, 18, 3]}, "box": {"lengths": [4.26, 0.1518, 1.047], "origin": [0, 0, 0]},
+           "material": {"E": 30020000000.0, "nu": 0.4871},
+           "loads": {"traction": {"z1": [8144000.0, -2975000.0, -552100.0], "x1": [5356000.0, 842100.0, 477700.0]},
+                     "body_force": [0, 0, -5700000.0]},
+           "friction": {"tresca": 274.9}, "obstacle": {"kind": "sphere", "radius": 10.37, "center": [1.465, 0.09493], "gap": 0}})"},
       {"measured_floor_plane",
        R"({"mesh": {"dims": [15, 2, 7]}, "box": {"lengths": [4.21, 0.4645, 0.09347], "origin": [0, 0, 0]},
            "material": {"E": 197700000.0, "nu": 0.4684}, "loads": {"traction": {"z1": [-12320.0, 12900.0, 16000.0]}},
@@ -421,6 +432,26 @@ TEST(TrescaDriver, ProblemsWhoseRResolvesLessThan1e10OfBConvergeToTheLevelMeasur
            "loads": {"traction": {"z1": [46400.0, -34960.0, 150400.0], "x1": [165900.0, -55710.0, 53580.0]}},
            "friction": {"tresca": 816.3}, "obstacle": {"kind": "plane", "gap": 0, "slope": [0.0006703, 0.0004091]}})"}};
   for (const auto& c : cases) expect_verified_answer(c.name, c.json, "that level is above 1e-10 |b~|");
+}
+
+TEST(TrescaDriver, TheFloorOfWhatRResolvesIsJudgedAtTheIterationLimit) {
+  // Drawn by perf/robustness_sweep.py --seed 29 (RESULTS.md §0zu), in full
+  // digits: a 10x22x6 plate (elements 117:1) pressed onto a cylinder. |w|
+  // reached 1e-13 |b~| at step 29, with eps = 1e-6 N out of reach (|b~| =
+  // 5.8e7 N); its fresh r put |w| at 7.4e-12 |b~|, Newton restarted from it
+  // at step 40, and the window after the restart completed at the limit of
+  // 50 steps, which ended the run (iteration_limit) before the floor was
+  // judged. The floor is now judged at the limit first.
+  expect_verified_answer("floor_at_the_limit",
+                         R"({"mesh": {"dims": [10, 22, 6]},
+                             "box": {"lengths": [4.770460139132136, 0.4983401656723042, 0.024423011671396978],
+                                     "origin": [0, 0, 0]},
+                             "material": {"E": 515420545327.9988, "nu": 0.3916128684625946},
+                             "loads": {"traction": {"z1": [81606185.1947415, 26417695.94391216, -372326519.57001895]}},
+                             "friction": {"tresca": 5882271.32201808},
+                             "obstacle": {"kind": "cylinder", "radius": 0.25652590635476497,
+                                          "y": 0.41943802728190777, "gap": 3.4097966020289344e-09}})",
+                         "is finer than r = S u - b~ resolves");
 }
 
 TEST(TrescaDriver, AStopTheFinalCheckDoesNotConfirmGoesOn) {

@@ -502,6 +502,7 @@ class NewtonSolve {
   static constexpr int kMaxRedos = 3;
   static constexpr real kStallTightening = 10;  // the least a step stopped at the outer limit tightens by
   static constexpr real kMeasuredFloorMax = 1e-8;  // relative to |b̃|: floor_cap
+  static constexpr real kFloorSpread = 4;          // floor_cap
   real step_rhs = 0, step_target = 0;  // the last step's |r_F| and accuracy asked (StepOutcome)
   real last_missed = 0;                // the factor the last step missed its accuracy by (check_step), 0: met
   int last_watchdog = std::numeric_limits<int>::min() / 2;  // the last step the watchdog took whole
@@ -684,16 +685,19 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
                                                                [=](index i) { return real(now[i] != before[i]); })));
   for_each_entry("newton states kept", p, Cost{2, 0}, [=](index i) { before[i] = now[i]; });
   if (R.last_state_changes > 0) last_change = k;
-  if (k >= opt.max_iterations) return NewtonReason::iteration_limit;
   // after a restart from a fresh r (floor_stop), the r summed from the
   // steps can fall again between the refreshes that put |w| back at the
   // fresh level, which the window test counts as progress: the floor is
   // judged again once a window has passed since the restart (a plate of
   // elements 24:1 alternated between 5e-6 and 6e-4 N to the iteration
-  // limit, RESULTS.md §0zt); once an iteration
-  const bool judged = window_from > 0 && k - window_from >= opt.stagnation_window;
+  // limit, RESULTS.md §0zt); and at the iteration limit, before it ends
+  // the run (a window completed there: a plate of elements 117:1 at
+  // 7e-12 |b̃| ended at the limit, §0zu); once an iteration
+  const bool at_limit = k >= opt.max_iterations;
+  const bool judged = at_limit || (window_from > 0 && k - window_from >= opt.stagnation_window);
   if (judged)
     if (const auto stop = floor_stop(k)) return stop;
+  if (at_limit) return NewtonReason::iteration_limit;
   const bool progress = R.last_state_changes > 0 && R.merit[k] < R.merit[k - 1];
   auto stagnating = [&] { return stagnated(R.merit, opt.stagnation_window, std::max(R.monotone_from, window_from)); };
   if (!progress && stagnating()) {
@@ -759,11 +763,11 @@ std::optional<NewtonReason> NewtonSolve::floor_stop(int k) {
 }
 
 // The largest level floor_stop calls the floor of what r resolves:
-// floor_rtol |b̃|, and above it (up to kMeasuredFloorMax |b̃|) what a fresh r
-// resolves at x as measured: the difference between the fresh r (warm from
-// the body) and a second one solved from a cold start to the same
-// tolerance, which is relative to the interior load (the warm one is often
-// better than that: the difference bounds it from above). Where S is a
+// floor_rtol |b̃|, and above it (up to kMeasuredFloorMax |b̃|) kFloorSpread
+// times what a fresh r resolves at x as measured: the difference between
+// the fresh r (warm from the body) and a second one solved from a cold
+// start to the same tolerance, which is relative to the interior load (a
+// sample of the size of a fresh r's error, not a bound). Where S is a
 // small difference of large terms (thin plates: an interior load 1.5e4
 // |b̃|), a fresh r at the tightest inner tolerance is exact only to
 // 1e-10-1e-9 |b̃|, and Newton's steps, each cancelling the last fresh r's
@@ -779,7 +783,12 @@ real NewtonSolve::floor_cap(real level, real& measured) {
   if (!work.residual(S, x.u.data(), cold, 1e-12, body, nullptr)) return cap;
   axpy(n3, -1, x.r.data(), cold);
   measured = std::sqrt(S.sum(dot(n3, cold, cold)));
-  return std::max(cap, measured);
+  // (the level is the largest |w| of a window whose fresh r each carry an
+  // error of their own, the measurement one difference of two such: their
+  // sizes spread by a factor 4 over a window, 0.04-0.17 N on a block of
+  // elements 41:1 whose two fresh r differed by 0.065 N, and tighter inner
+  // solves do not lower them, the arithmetic's limit: RESULTS.md §0zu)
+  return std::max(cap, kFloorSpread * measured);
 }
 
 // 2. linearisation: known increments, free set, H, right-hand side, and
