@@ -474,8 +474,8 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
                 "      is out of reach for this problem's magnitudes (--eps %.0e would be met)\n",
                 N.history.back() / N.history.front(), eps, std::pow(10.0, std::ceil(std::log10(2 * N.history.back()))));
   if (N.residual_floor > 0) {
-    std::printf("note: eps = %.1e N is finer than r = S u - b~ resolves for this problem: |v| stayed at or below\n"
-                "      %.1e N (%.1e |b~|) for %d Newton steps with no contact state changed; converged to that\n"
+    std::printf("note: eps = %.1e N is finer than r = S u - b~ resolves for this problem: |v| settled at or below\n"
+                "      %.1e N (%.1e |b~|), no contact state changed for %d Newton steps; converged to that\n"
                 "      level, confirmed with a fresh r (--eps %.0e asks for no more)\n",
                 eps, N.residual_floor, N.residual_floor / F.btilde_norm, c.opt.newton.stagnation_window,
                 std::pow(10.0, std::ceil(std::log10(N.residual_floor))));
