@@ -469,7 +469,8 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
   std::printf("true residual (fresh S u - b~): %.3e absolute, %.3e relative to |b~| %s %.3e%s\n", F.true_residual,
               F.true_residual_relative, R.btilde_estimated ? "~" : "=", F.btilde_norm,
               R.btilde_estimated ? " (from the coarser mesh)" : "");
-  if (N.reason == NewtonReason::stagnation && !N.history.empty() && N.history.back() <= 1e-9 * N.history.front())
+  if ((N.reason == NewtonReason::stagnation || N.reason == NewtonReason::iteration_limit) && !N.history.empty() &&
+      N.history.back() <= 1e-9 * N.history.front())
     std::printf("note: |v| stagnated at %.1e of its initial value, the accuracy the inner solves attain: eps = %.1e\n"
                 "      is out of reach for this problem's magnitudes (--eps %.0e would be met)\n",
                 N.history.back() / N.history.front(), eps, std::pow(10.0, std::ceil(std::log10(2 * N.history.back()))));

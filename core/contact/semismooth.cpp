@@ -705,12 +705,12 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
       if (const auto stop = floor_stop(k)) return stop;
     if (!stagnating()) return std::nullopt;  // (r refreshed: the window starts again)
     // the non-monotone search let Newton wander (NewtonOptions::line_search):
-    // from here on each step must lower |w|, and stagnation is judged anew;
-    // not at the floor of what r resolves, where no search makes progress
+    // from here on each step must lower the merit, and the window test no
+    // longer ends the run; not at the floor of what r resolves, where no
+    // search makes progress
     const bool at_floor = *std::min_element(R.merit.begin(), R.merit.end()) <= resolved();
-    if (!opt.line_search || opt.line_search_memory == 0 || R.monotone_from >= 0 || at_floor)
-      return NewtonReason::stagnation;
-    R.monotone_from = k;
+    if (!opt.line_search || opt.line_search_memory == 0 || at_floor) return NewtonReason::stagnation;
+    if (R.monotone_from < 0) R.monotone_from = k;
   }
   return std::nullopt;
 }
@@ -723,8 +723,9 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
 // the r it is computed from. Where some |w| of the window is at most
 // floor_rtol |b̃| (elsewhere nothing changes), r is solved afresh at x (warm
 // from the body, to the tightest inner tolerance). Where that r's |w| is
-// within the window's level, and the level is at most floor_rtol |b̃|, x is
-// a solution to that level: converged, the level the tolerance
+// within the window's level, and the level is at most floor_rtol |b̃| or
+// what a fresh r resolves at x as measured (floor_cap), x is a solution to
+// that level: converged, the level the tolerance
 // (NewtonResult::residual_floor). Where the fresh r is further from a
 // solution than the r summed from the steps, and above what r resolves (r
 // drifted: the increments carried more error than counted), Newton goes on

@@ -149,13 +149,16 @@ struct NewtonOptions {
   // some node's state and lower the merit (a front of separation that
   // advances a node or two a step is slow progress, not stagnation; the
   // iteration limit bounds it). The first time the window test holds, the
-  // search turns monotone instead (memory 0: each step must lower |w|) and
-  // the window starts again from there; stagnation is declared only if it
-  // holds again (NewtonResult::monotone_from). A semismooth Newton that
-  // cycles between two active sets, each step's |w| inside the window's
-  // maximum, is pulled out of the cycle: a 6x17x6 block on a cylinder cycled
-  // between 17 and 18 nodes in contact and now converges (RESULTS.md §0zq).
-  // Runs that converge without it never reach the test and are unchanged.
+  // search turns monotone instead (memory 0: each step must lower the
+  // merit; NewtonResult::monotone_from), and from there the window test no
+  // longer ends the run: Newton cannot cycle, a slow descent is progress,
+  // and the iteration limit bounds it (a 9x5x6 block of elements 68:1 crept
+  // for 19 steps after the switch and converged at step 39, RESULTS.md
+  // §0zu). A semismooth Newton that cycles between two active sets, each
+  // step's |w| inside the window's maximum, is pulled out of the cycle: a
+  // 6x17x6 block on a cylinder cycled between 17 and 18 nodes in contact
+  // and now converges (§0zq). Runs that converge without it never reach
+  // the test and are unchanged.
   // Off: full steps, and only the second test.
   bool line_search = true;
   // Far from the solution the search's merit is the problem's own: the
