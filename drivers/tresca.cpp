@@ -523,7 +523,7 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
                 "CG's limit short of its target, or its check found it worse than no step)\n",
                 N.redone_steps);
   if (N.monotone_from >= 0)
-    std::printf("note: from Newton step %d on each step had to lower |w| (a monotone line search): the "
+    std::printf("note: from Newton step %d on each step had to lower its merit (a monotone line search): the "
                 "non-monotone search had made no progress\n",
                 N.monotone_from);
   if (N.inner_tightening > 1)

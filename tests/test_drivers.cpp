@@ -611,6 +611,25 @@ TEST(TrescaDriver, ASlowFrontOfSeparationIsNotStagnation) {
   EXPECT_LE(newton_steps(nested.out), 8) << nested.out;  // (4 when written)
 }
 
+TEST(TrescaDriver, ASlowDescentUnderTheMonotoneSearchIsNotStagnation) {
+  // Drawn by perf/robustness_sweep.py --seed 19 (RESULTS.md §0zu), rounded
+  // to 4 digits: a 9x5x6 plate 0.038 m thick (elements 68:1), nu = -0.45,
+  // a Tresca bound of 3.5e7 N, on a sphere. After the search turned
+  // monotone at step 10, |w| crept from 3.8e8 N to 2.4e8 N in ten steps at
+  // lengths 1/32-1/8 while nodes began to stick, no new best by half:
+  // "not converged (stagnation)" at step 24. The window test no longer ends
+  // a run under the monotone search; it converges (38 steps when written).
+  const std::string out = expect_verified_answer(
+      "slow_monotone_descent",
+      R"({"mesh": {"dims": [9, 5, 6]}, "box": {"lengths": [3.887, 0.8918, 0.03803], "origin": [0, 0, 0]},
+          "material": {"E": 564400000000.0, "nu": -0.4479},
+          "loads": {"traction": {"z1": [72870000.0, -54980000.0, -241800000.0], "x1": [255000000.0, -18990000.0, 5642000.0]},
+                    "body_force": [0, 0, -10380000000.0]},
+          "friction": {"tresca": 35380000.0}, "obstacle": {"kind": "sphere", "radius": 31.3, "center": [3.026, 0.2575], "gap": 0}})",
+      "a monotone line search");
+  EXPECT_GE(newton_steps(out), 25) << out;  // (past the step the window test ended it before)
+}
+
 TEST(TrescaDriver, StepsSolvedWithTooInexactSProductsAreSolvedAgain) {
   // Drawn by perf/robustness_sweep.py (RESULTS.md §0zt). Plates of elements
   // 220-750 times longer than wide (Coulomb, on a plane and on cylinders):

@@ -705,11 +705,14 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
       if (const auto stop = floor_stop(k)) return stop;
     if (!stagnating()) return std::nullopt;  // (r refreshed: the window starts again)
     // the non-monotone search let Newton wander (NewtonOptions::line_search):
-    // from here on each step must lower the merit, and the window test no
-    // longer ends the run; not at the floor of what r resolves, where no
+    // from here on each step must lower the merit, and where that merit
+    // descends an energy to its minimiser (the envelope), the window test
+    // no longer ends the run; not at the floor of what r resolves, where no
     // search makes progress
     const bool at_floor = *std::min_element(R.merit.begin(), R.merit.end()) <= resolved();
-    if (!opt.line_search || opt.line_search_memory == 0 || at_floor) return NewtonReason::stagnation;
+    const bool descends_energy = opt.envelope_merit && envelope_applies(opt.scaling, opt.friction);
+    if (!opt.line_search || opt.line_search_memory == 0 || at_floor || (R.monotone_from >= 0 && !descends_energy))
+      return NewtonReason::stagnation;
     if (R.monotone_from < 0) R.monotone_from = k;
   }
   return std::nullopt;

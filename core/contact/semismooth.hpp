@@ -150,9 +150,12 @@ struct NewtonOptions {
   // advances a node or two a step is slow progress, not stagnation; the
   // iteration limit bounds it). The first time the window test holds, the
   // search turns monotone instead (memory 0: each step must lower the
-  // merit; NewtonResult::monotone_from), and from there the window test no
-  // longer ends the run: Newton cannot cycle, a slow descent is progress,
-  // and the iteration limit bounds it (a 9x5x6 block of elements 68:1 crept
+  // merit; NewtonResult::monotone_from), and from there, where the merit
+  // far from the solution is an energy's envelope (envelope_merit), the
+  // window test no longer ends the run: Newton cannot cycle, a descent to
+  // the energy's minimiser is progress however slow, and the iteration
+  // limit bounds it (where no energy is minimised, Coulomb's Newton, a
+  // second holding ends it: stagnation; a 9x5x6 block of elements 68:1 crept
   // for 19 steps after the switch and converged at step 39, RESULTS.md
   // §0zu). A semismooth Newton that cycles between two active sets, each
   // step's |w| inside the window's maximum, is pulled out of the cycle: a
