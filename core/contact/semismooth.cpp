@@ -476,6 +476,9 @@ class NewtonSolve {
   InnerWork work;
   NewtonResult R;
   real fscale = 1;  // |b̃|
+  // the line search's merit far from the solution is an energy's envelope
+  // (NewtonOptions::envelope_merit: envelope_along_step, record)
+  bool descends_energy() const { return opt.envelope_merit && envelope_applies(opt.scaling, opt.friction); }
   // what r resolves at its tightest (Tolerances: residual_accuracy |b̃|)
   real resolved() const { return opt.residual_accuracy * fscale; }
   real r_err = 0;   // bounds the error of the current r
@@ -710,8 +713,7 @@ std::optional<NewtonReason> NewtonSolve::record(int k) {
     // no longer ends the run; not at the floor of what r resolves, where no
     // search makes progress
     const bool at_floor = *std::min_element(R.merit.begin(), R.merit.end()) <= resolved();
-    const bool descends_energy = opt.envelope_merit && envelope_applies(opt.scaling, opt.friction);
-    if (!opt.line_search || opt.line_search_memory == 0 || at_floor || (R.monotone_from >= 0 && !descends_energy))
+    if (!opt.line_search || opt.line_search_memory == 0 || at_floor || (R.monotone_from >= 0 && !descends_energy()))
       return NewtonReason::stagnation;
     if (R.monotone_from < 0) R.monotone_from = k;
   }
@@ -761,18 +763,19 @@ std::optional<NewtonReason> NewtonSolve::floor_stop(int k) {
     const real restart_merit = R.merit[size_t(window_from)];  // (the fresh r's |w| there)
     if (merit > 0.5 * restart_merit) level = std::max({level, merit, restart_merit});
   }
-  real measured = 0;  // (what r resolves, where floor_cap measured it)
-  // The window's level, or where that is above the floor, the level |w|
-  // settled at after Newton's last steps to it, the fresh |w| included (a
-  // block of elements 22:1 went from 3.8 N to 6.5e-6 N in two steps and
-  // stayed at 5.9-6.8e-6 N for eight, to the iteration limit: §0zu)
-  if (merit <= level && level > floor_cap(level, measured))
-    level = std::max({settled_max, merit, resolved()});
-  if (merit <= level && level <= floor_cap(level, measured)) {
-    R.residual_floor = level;
-    R.floor_measured = level > opt.floor_rtol * fscale ? measured : 0;
-    R.tolerance = level;
-    return NewtonReason::converged;
+  if (merit <= level) {
+    real measured = 0;  // (what r resolves, where floor_cap measured it)
+    // The window's level, or where that is above the floor, the level |w|
+    // settled at after Newton's last steps to it, the fresh |w| included (a
+    // block of elements 22:1 went from 3.8 N to 6.5e-6 N in two steps and
+    // stayed at 5.9-6.8e-6 N for eight, to the iteration limit: §0zu)
+    if (level > floor_cap(level, measured)) level = std::max({settled_max, merit, resolved()});
+    if (level <= floor_cap(level, measured)) {
+      R.residual_floor = level;
+      R.floor_measured = level > opt.floor_rtol * fscale ? measured : 0;
+      R.tolerance = level;
+      return NewtonReason::converged;
+    }
   }
   if (merit > 2 * summed && merit > resolved() && window_from == 0) window_from = k;
   return std::nullopt;
@@ -920,7 +923,7 @@ std::optional<NewtonReason> NewtonSolve::take_step() {
 // envelope's change is of the order of |w|² / s, it leaves the decision
 // to |w|.
 std::function<std::optional<real>(real)> NewtonSolve::envelope_along_step(const real* Sdu) {
-  if (!opt.envelope_merit || !envelope_applies(opt.scaling, opt.friction)) return {};
+  if (!descends_energy()) return {};
   const real* u = x.u.data();
   const real* r = x.r.data();
   const real* d = du.data();
