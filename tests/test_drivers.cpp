@@ -630,6 +630,29 @@ TEST(TrescaDriver, ASlowDescentUnderTheMonotoneSearchIsNotStagnation) {
   EXPECT_GE(newton_steps(out), 25) << out;  // (past the step the window test ended it before)
 }
 
+TEST(TrescaDriver, ACoarseMeshOfNestedIterationHasMoreStepsThanTheFinest) {
+  // Drawn by perf/robustness_sweep.py --seed 7 (RESULTS.md §0zv), rounded
+  // to 4 digits: a 36x9x4 cantilever 4.4 m long and 0.1 m thick on a
+  // sphere, pressed and pushed sideways. Its coarse mesh 18x5x2 converged
+  // at step 61, past the limit of 50 it shared with the finest mesh; not
+  // used, the finest mesh crept from a cold start at lengths 1/64-1/4 to
+  // "not converged (iteration_limit)" at 3.4e2 N. The coarse meshes now
+  // have 4 times the finest mesh's limit, and the finest starts near the
+  // solution (16 steps when written).
+  const std::string out = expect_verified_answer(
+      "coarse_mesh_limit",
+      R"({"mesh": {"dims": [36, 9, 4]}, "box": {"lengths": [4.447, 0.1771, 0.09897], "origin": [0, 0, 0]},
+          "material": {"E": 3591000.0, "nu": 0.06722},
+          "loads": {"traction": {"z1": [401.3, -9.737, -1177.0], "y0": [275.1, -527.0, 202.4]}},
+          "friction": {"tresca": 8.896}, "obstacle": {"kind": "sphere", "radius": 5.405, "center": [2.799, 0.02089], "gap": 0}})");
+  EXPECT_LE(newton_steps(out), 30) << out;
+  // 4 times the finest mesh's limit on every coarse mesh, not 4 times a
+  // coarse mesh's own: a slow front on a bar stops at 4 steps on both
+  for (const char* mesh : {"50x1x1", "100x1x1"})
+    expect_run("tresca --dims 200x1x1 --phi 1e7 --max-newton 1", 1,
+               std::string("nested: mesh ") + mesh + " solved in 4 Newton steps (not converged: not used)");
+}
+
 TEST(TrescaDriver, StepsSolvedWithTooInexactSProductsAreSolvedAgain) {
   // Drawn by perf/robustness_sweep.py (RESULTS.md §0zt). Plates of elements
   // 220-750 times longer than wide (Coulomb, on a plane and on cylinders):

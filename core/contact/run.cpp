@@ -58,6 +58,8 @@ void solve_coarser_mesh(const ProblemSpec& spec, const RunOptions& opt, RunResul
   co.iterate_done = nullptr;
   co.phase_done = nullptr;  // one line per coarse mesh: nested_done
   co.newton.rtol = opt.nested_rtol;
+  co.newton.max_iterations = opt.newton.max_iterations * std::max(1, opt.nested_iteration_factor);
+  co.nested_iteration_factor = 1;
   co.coulomb_tol = std::max(opt.coulomb_tol, opt.nested_rtol);
   // and need their forces only to a fraction of that accuracy
   co.tight_rtol = std::max(opt.tight_rtol, 1e-3 * opt.nested_rtol);

@@ -62,6 +62,14 @@ struct RunOptions {
   // compute r = S u - b̃ to 1e-3 nested_rtol (chosen by measurement:
   // perf/RESULTS.md §0i)
   real nested_rtol = 1e-3;
+  // the coarse meshes' Newton iteration limit: this factor times the
+  // finest mesh's (NewtonOptions::max_iterations). A coarse mesh's step
+  // costs an eighth of the next finer one's, and a coarse mesh that
+  // converges hands up an iterate near the solution: two plates and a
+  // cantilever whose coarse meshes converged at steps 52-63 ended at the
+  // finest mesh's limit of 50 from a cold start instead (perf/RESULTS.md
+  // §0zv). Applied once: the coarse meshes of a coarse mesh get the same.
+  int nested_iteration_factor = 4;
   real tight_rtol = 1e-12;
   // the final check's verdict: KKT in consistent units within
   // max(Newton's tolerance, kkt_rtol |b̃|) (100 times what the check resolves)
