@@ -64,7 +64,8 @@ struct RunOptions {
   real nested_rtol = 1e-3;
   // the coarse meshes' Newton iteration limit: this factor times the
   // finest mesh's (NewtonOptions::max_iterations). A coarse mesh's step
-  // costs an eighth of the next finer one's, and a coarse mesh that
+  // costs about an eighth of the next finer one's (a half on a bar one
+  // element wide and thick), and a coarse mesh that
   // converges hands up an iterate near the solution: two plates and a
   // cantilever whose coarse meshes converged at steps 52-63 ended at the
   // finest mesh's limit of 50 from a cold start instead (perf/RESULTS.md
