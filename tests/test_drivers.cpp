@@ -648,9 +648,12 @@ TEST(TrescaDriver, ACoarseMeshOfNestedIterationHasMoreStepsThanTheFinest) {
   EXPECT_LE(newton_steps(out), 30) << out;
   // 4 times the finest mesh's limit on every coarse mesh, not 4 times a
   // coarse mesh's own: a slow front on a bar stops at 4 steps on both
+  const CmdResult bar = run("tresca --dims 200x1x1 --phi 1e7 --max-newton 1");
+  EXPECT_EQ(bar.status, 1) << bar.out;
   for (const char* mesh : {"50x1x1", "100x1x1"})
-    expect_run("tresca --dims 200x1x1 --phi 1e7 --max-newton 1", 1,
-               std::string("nested: mesh ") + mesh + " solved in 4 Newton steps (not converged: not used)");
+    EXPECT_NE(bar.out.find(std::string("nested: mesh ") + mesh + " solved in 4 Newton steps (not converged: not used)"),
+              std::string::npos)
+        << bar.out;
 }
 
 TEST(TrescaDriver, StepsSolvedWithTooInexactSProductsAreSolvedAgain) {
