@@ -25,7 +25,7 @@ using namespace tresca;
 
 namespace {
 
-const char* kHelp =
+const std::string kHelp =
     "usage: tresca [options]\n"
     "  --problem FILE     the case from a JSON problem file (drivers/cases/README.md); the\n"
     "                     options below override it\n"
@@ -53,7 +53,8 @@ const char* kHelp =
     "                     (default 1e-6, absolute; --table: on the paper's |v|, its rule (11))\n"
     "  --E E, --nu NU     material (default 2.1e9, 0.277)\n"
     "  --max-newton N     Newton iteration limit (default 50; the coarser meshes of nested\n"
-    "                     iteration: 4 N, as their steps cost an eighth)\n"
+    "                     iteration: " + std::to_string(RunOptions{}.nested_iteration_factor) +
+    " N, as their steps cost an eighth)\n"
     "  --merit envelope|residual  the line search's merit far from the solution: the forward-\n"
     "                     backward envelope of the Tresca energy (default) or |w| alone; |w|\n"
     "                     decides near the solution either way\n"
@@ -639,7 +640,7 @@ int main(int argc, char** argv) {
                   "--coulomb", "--coulomb-method", "--obstacle", "--load-scale", "--problem", "--gap-file",
                   "--vtk-format", "--initial", "--device", "--merit"},
                  {"--quiet", "--profile", "--no-nested", "--vtk-every-iteration"});
-    if (answered_help_or_version(a, "tresca", kHelp)) return 0;
+    if (answered_help_or_version(a, "tresca", kHelp.c_str())) return 0;
     parse_command(a, comm, c);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tresca: error: %s\n", e.what());
