@@ -29,6 +29,11 @@ TEST(Nested, CoarserMeshHalvesEveryAxisRoundingUp) {
   EXPECT_TRUE(has_coarser(spec_for_dims(100, 1, 1), 64));  // 50x1x1: a bar may stay one element thick
   EXPECT_TRUE(has_coarser(spec_for_dims(64, 32, 2), 64));  // 32x16x1: and a plate
   EXPECT_FALSE(has_coarser(spec_for_dims(2, 20, 20), 1));  // 1x10x10: x keeps 2 elements
+  // the default's floor: level 8 (64x32x32) goes down to 8x4x4 (40 contact
+  // nodes), not to 4x2x2 (12)
+  const index floor = RunOptions{}.nested_min_contact_nodes;
+  EXPECT_TRUE(has_coarser(spec_for_dims(16, 8, 8), floor));
+  EXPECT_FALSE(has_coarser(spec_for_dims(8, 4, 4), floor));
 }
 
 TEST(Nested, ContactAreasTileTheFace) {
