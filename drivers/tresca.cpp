@@ -516,6 +516,10 @@ void print_report(const Command& c, const RunResult& R, const Comm& comm) {
   if (N.watchdog_steps > 0)
     std::printf("note: %d Newton steps were taken whole where no step length decreased |w| (the line search's watchdog)\n",
                 N.watchdog_steps);
+  if (!R.cold_restart_after.empty())
+    std::printf("note: Newton from the coarser mesh's solution ended %s after %d steps; the run was solved again\n"
+                "      from x0 = 0 (the lines above: both solves; the work and the total time: both)\n",
+                R.cold_restart_after.c_str(), R.cold_restart_steps);
   if (R.resumed_from >= 0)
     std::printf("note: the final check did not confirm the stop after step %d (|w| <= eps, a KKT field above it):\n"
                 "      Newton went on to eps %.1e, %d more steps\n",

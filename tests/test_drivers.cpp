@@ -669,6 +669,31 @@ TEST(TrescaDriver, ACoarseMeshOfNestedIterationHasMoreStepsThanTheFinest) {
         << bar.out;
 }
 
+TEST(TrescaDriver, NewtonThatFailsFromTheCoarseSolutionIsSolvedAgainFromZero) {
+  // Drawn by perf/robustness_sweep.py --seed 19 (RESULTS.md §0zw), rounded
+  // to 4 digits: a plate 35x1x9 elements 0.025 m thick (100:1) pulled off a
+  // plane. Since nested iteration goes down to 16 contact nodes its finest
+  // mesh starts from the solution of 18x1x5 (|w| 1.2e4 times |b~|) and
+  // creeps to the iteration limit, where x0 = 0 converges in 19 steps (the
+  // same start at 32 contact nodes failed on an Intel host too, RESULTS.md
+  // §0zv); the run is now solved again from x0 = 0
+  const std::string json =
+      R"({"mesh": {"dims": [35, 1, 9]}, "box": {"lengths": [1.311, 0.2786, 0.02506], "origin": [0, 0, 0]},
+          "material": {"E": 154100000000.0, "nu": 0.4673},
+          "loads": {"traction": {"z1": [-35510000.0, -2952000.0, 22260000.0]}},
+          "friction": {"tresca": 6329000.0}, "obstacle": {"kind": "plane", "gap": 8.461e-06, "slope": [0.0006522, 0.0009863]}})";
+  const std::string json_out = ::testing::TempDir() + "/cold_restart.out.json";
+  const std::string out = expect_verified_answer(
+      "cold_restart", json, "note: Newton from the coarser mesh's solution ended iteration_limit after 50 steps",
+      "--json " + json_out);
+  EXPECT_EQ(newton_steps(out), 19) << out;  // (the cold solve's steps, as --no-nested's)
+  const auto j = nlohmann::json::parse(slurp(json_out));
+  EXPECT_EQ(j["cold_restart"]["after"], "iteration_limit");
+  EXPECT_EQ(j["cold_restart"]["newton_iterations"], 50);
+  ASSERT_EQ(j["nested"].size(), 2u);  // (solved, and in the work: still listed)
+  EXPECT_EQ(j["nested"][1]["dims"], nlohmann::json::array({18, 1, 5}));
+}
+
 TEST(TrescaDriver, StepsSolvedWithTooInexactSProductsAreSolvedAgain) {
   // Drawn by perf/robustness_sweep.py (RESULTS.md §0zt). Plates of elements
   // 220-750 times longer than wide (Coulomb, on a plane and on cylinders):

@@ -60,6 +60,7 @@ void solve_coarser_mesh(const ProblemSpec& spec, const RunOptions& opt, RunResul
   co.newton.rtol = opt.nested_rtol;
   co.newton.max_iterations = opt.newton.max_iterations * std::max(1, opt.nested_iteration_factor);
   co.nested_iteration_factor = 1;
+  co.cold_restart = false;
   co.coulomb_tol = std::max(opt.coulomb_tol, opt.nested_rtol);
   // and need their forces only to a fraction of that accuracy
   co.tight_rtol = std::max(opt.tight_rtol, 1e-3 * opt.nested_rtol);
@@ -468,16 +469,34 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   R.peak_device_memory = launch_on_device() ? block_reuse(Space::device).peak_bytes : 0;
 
   // A failed Coulomb Newton solve is redone as the fixed point of Tresca
-  // solves (each globalised by the line search), its work and time added to
-  // the new run's
-  const bool coulomb_failed = R.coulomb() && opt.friction.method != FrictionLaw::CoulombMethod::fixed_point &&
-                              (R.newton.reason == NewtonReason::stagnation || R.newton.reason == NewtonReason::iteration_limit);
-  if (!coulomb_failed) return R;
+  // solves (each globalised by the line search), and a failed Tresca solve
+  // that started from the coarser mesh's solution is redone from x0 = 0
+  // (RunOptions::cold_restart); either way the first run's work and time
+  // are added to the new run's
+  const bool stalled = R.newton.reason == NewtonReason::stagnation || R.newton.reason == NewtonReason::iteration_limit;
+  const bool coulomb_failed = stalled && R.coulomb() && opt.friction.method != FrictionLaw::CoulombMethod::fixed_point;
+  const bool from_coarse = opt.nested && !opt.newton.u0 && !R.nested.empty() && R.nested.back().converged;
+  const bool cold_again = stalled && !R.coulomb() && opt.cold_restart && from_coarse;
+  if (!coulomb_failed && !cold_again) return R;
   RunOptions f = opt;
-  f.friction.method = FrictionLaw::CoulombMethod::fixed_point;
-  if (opt.phase_done) opt.phase_done("Coulomb: one Newton solve did not converge; again by the fixed point", R.times.total);
+  if (coulomb_failed) {
+    f.friction.method = FrictionLaw::CoulombMethod::fixed_point;
+    if (opt.phase_done) opt.phase_done("Coulomb: one Newton solve did not converge; again by the fixed point", R.times.total);
+  } else {
+    f.nested = false;
+    if (opt.phase_done) {
+      const std::string what = std::string("Newton from the coarser mesh's solution ended ") + to_string(R.newton.reason) +
+                               "; again from x0 = 0";
+      opt.phase_done(what.c_str(), R.times.total);
+    }
+  }
   RunResult again = run_tresca(spec, f);
-  again.coulomb_fallback = true;
+  again.coulomb_fallback = coulomb_failed;
+  if (cold_again) {
+    again.cold_restart_after = to_string(R.newton.reason);
+    again.cold_restart_steps = R.newton.iterations;
+    again.nested = std::move(R.nested);  // (solved, and in the work: the report lists them)
+  }
   again.fine_matvecs_total += R.fine_matvecs_total;
   again.times.total += R.times.total;
   return again;

@@ -73,6 +73,13 @@ struct RunOptions {
   // finest mesh's limit of 50 from a cold start instead (perf/RESULTS.md
   // §0zv). Applied once: the coarse meshes of a coarse mesh get the same.
   int nested_iteration_factor = 4;
+  // a Tresca run whose Newton started from the coarser mesh's solution and
+  // ended in stagnation or at the iteration limit is solved again from
+  // x0 = 0 (RunResult::cold_restart_after): on slender plates and bars a
+  // coarse solution can be a start from which Newton creeps where x0 = 0
+  // converges (perf/RESULTS.md §0zw). The finest mesh only: a coarse
+  // mesh that fails is not used.
+  bool cold_restart = true;
   real tight_rtol = 1e-12;
   // the final check's verdict: KKT in consistent units within
   // max(Newton's tolerance, kkt_rtol |b̃|) (100 times what the check resolves)
@@ -147,6 +154,11 @@ struct RunResult {
   // from, and the eps it went on to (run.cpp: resume_after_check); -1: none
   int resumed_from = -1;
   real resumed_eps = 0;
+  // RunOptions::cold_restart: how Newton from the coarser mesh's solution
+  // ended before the run was solved again from x0 = 0, and its steps (their
+  // work and time are in the totals); empty: no such restart
+  std::string cold_restart_after;
+  int cold_restart_steps = 0;
   long long newton_steps() const { return coulomb() ? coulomb_loop.newton_steps : newton.iterations; }
   double newton_fine_matvecs() const { return coulomb() ? coulomb_loop.fine_matvecs : newton.fine_matvecs; }
   double fine_matvecs_per_newton_step() const {

@@ -90,6 +90,9 @@ Json run_summary(const ProblemSpec& spec, const RunResult& R, int threads, const
   j["converged"] = R.converged();
   j["reason"] = R.reason();
   j["initial_iterate"] = R.initial_iterate.empty() ? Json(nullptr) : Json(R.initial_iterate);
+  j["cold_restart"] = R.cold_restart_after.empty()
+                          ? Json(nullptr)
+                          : Json{{"after", R.cold_restart_after}, {"newton_iterations", R.cold_restart_steps}};
   j["stopping_rule"] = N.stop == StopRule::consistent ? "consistent" : "paper";
   j["tolerance"] = N.tolerance;
   j["residual_floor"] = N.residual_floor;  // > 0: converged at this level of what r resolves, above eps [N]
