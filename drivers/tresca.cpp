@@ -62,7 +62,10 @@ const std::string kHelp =
     "                     displacements added as numbers; needs near-exact steps) or the\n"
     "                     diagonal of K_cc per node (default; with --table: paper)\n"
     "  --no-nested        start Newton from x0 = 0 on this mesh (default: nested iteration,\n"
-    "                     coarser meshes ceil(e/2) solved first; --table never nests)\n"
+    "                     coarser meshes ceil(e/2) solved first, down to " +
+    std::to_string(RunOptions{}.nested_min_contact_nodes) + " contact nodes; a\n"
+    "                     Tresca run whose Newton stalls from their solution is solved again\n"
+    "                     from x0 = 0; --table never nests)\n"
     "  --outer-pc mg|none preconditioner of the boundary Newton system (default mg)\n"
     "  --mg-degree D                 Chebyshev smoothing steps before and after each coarse\n"
     "                                correction of the V-cycles (default 3, 1..8)\n"
