@@ -55,8 +55,9 @@ struct RunOptions {
   std::function<void(const Iterate&)> iterate_done;
   // nested iteration (nested.hpp): coarser meshes first, down to meshes of
   // at least nested_min_contact_nodes contact nodes (has_coarser); off:
-  // x0 = 0 (the paper). 16, not 64: a third fewer fine matvecs on the
-  // random problems whose chain it lengthens (perf/RESULTS.md §0zw)
+  // x0 = 0 (the paper). 16, not 64: 28 % fewer fine matvecs on the random
+  // problems whose chain it lengthens, as many converged (perf/RESULTS.md
+  // §0zw)
   bool nested = true;
   index nested_min_contact_nodes = 16;
   // the coarse meshes stop at |v̂| <= nested_rtol |v̂_0| (their solutions

@@ -783,9 +783,8 @@ std::optional<NewtonReason> NewtonSolve::floor_stop(int k) {
 
 // The largest level floor_stop calls the floor of what r resolves:
 // floor_rtol |b̃|, and above it (up to kMeasuredFloorMax |b̃|, a sanity
-// bound: 1e-8 |b̃| left plates whose r resolves no better than 1.1e-8 to
-// 1.3e-8 |b̃| stagnating, where their two fresh r differed by 2e-5 |b̃|,
-// RESULTS.md §0zw) kFloorSpread
+// bound: at 1e-8 a plate whose |w| settled at 1.07e-8 |b̃| stagnated,
+// where its two fresh r differed by 4.9e-6 |b̃|, RESULTS.md §0zw) kFloorSpread
 // times what a fresh r resolves at x as measured: the difference between
 // the fresh r (warm from the body) and a second one solved from a cold
 // start to the same tolerance, which is relative to the interior load (a
