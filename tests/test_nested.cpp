@@ -123,7 +123,8 @@ void nested_equals_cold(real phi, real gap) {
 // contact nodes Newton stopped at a |w| summed from its steps of 9.6e-7 N
 // under eps = 1e-6 N, which the final check's fresh r put at 1.005e-6 N:
 // kkt_check_failed. A stop whose fresh |w| is above the tolerance now goes
-// on from that r (run.cpp: resume_after_check), as one whose KKT fields are
+// on from that r (run.cpp: resume_after_check), as one whose KKT fields
+// missed did before
 TEST(Nested, AStopTheFreshResidualPutsAboveEpsGoesOn) {
   const ProblemFile file = parse_problem(
       R"({"mesh": {"dims": [5, 22, 5]}, "box": {"lengths": [1.5440838202572529, 0.16594516425759093, 1.7502786259650362],

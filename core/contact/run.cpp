@@ -480,7 +480,7 @@ RunResult run_tresca(const ProblemSpec& spec, const RunOptions& opt) {
   // are added to the new run's
   const bool stalled = R.newton.reason == NewtonReason::stagnation || R.newton.reason == NewtonReason::iteration_limit;
   const bool coulomb_failed = stalled && R.coulomb() && opt.friction.method != FrictionLaw::CoulombMethod::fixed_point;
-  const bool from_coarse = opt.nested && !opt.newton.u0 && !R.nested.empty() && R.nested.back().converged;
+  const bool from_coarse = !opt.newton.u0 && !R.nested.empty() && R.nested.back().converged;
   const bool cold_again = stalled && !R.coulomb() && opt.cold_restart && from_coarse;
   if (!coulomb_failed && !cold_again) return R;
   RunOptions f = opt;
