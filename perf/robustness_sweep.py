@@ -6,12 +6,13 @@ proportions, elements up to 100 times longer than wide, auxetic to nearly
 incompressible materials, Tresca bounds from a thousandth to a hundred times
 the mean contact force, Coulomb F up to 3, plane, sphere and cylinder
 obstacles with and without a gap, loads that press, shear and lift. This
-draws such problems (small meshes: a second or less each), solves each and
+draws such problems (small meshes: a second or less each; --refine K: the
+same problems on meshes K times finer per axis), solves each and
 tallies the outcome by reason. A run that ends without an answer must say
 so (exit 1 with its reason); exit 2 (bad input) means this generator made an
 invalid problem, and anything else is a defect.
 
-  python3 perf/robustness_sweep.py [--seed S] [--count N] [--bin build/bin/tresca]
+  python3 perf/robustness_sweep.py [--seed S] [--count N] [--refine K] [--bin build/bin/tresca]
                                    [--jobs J] [--keep DIR] [--compare OTHER_BIN]
 
 --compare runs every problem with a second binary as well (an A/B of a
@@ -31,8 +32,10 @@ import time
 from collections import Counter
 
 
-def draw(rng):
-    """One valid problem file's contents (drivers/cases/README.md schema)."""
+def draw(rng, refine=1):
+    """One valid problem file's contents (drivers/cases/README.md schema); refine
+    K > 1: the same problem (the same draws) on a mesh K times finer per axis,
+    its Tresca bound per contact node scaled so that the bound per area stays."""
     def log_uniform(a, b):
         return 10 ** rng.uniform(math.log10(a), math.log10(b))
     while True:
@@ -54,7 +57,8 @@ def draw(rng):
         loads["body_force"] = [0, 0, -rng.uniform(0, 1) * s / LZ]
     mean_force = abs(top[2]) * LX * LY / (ex * (ey + 1)) + 1e-30  # per contact node
     if rng.random() < 0.6:
-        friction = {"tresca": mean_force * log_uniform(1e-3, 1e2)}
+        per_area = ex * (ey + 1) / (refine * ex * (refine * ey + 1))
+        friction = {"tresca": mean_force * log_uniform(1e-3, 1e2) * per_area}
     else:
         friction = {"coulomb": rng.uniform(0, 1) if rng.random() < 0.5 else log_uniform(1e-3, 3)}
     kind = rng.random()
@@ -67,7 +71,7 @@ def draw(rng):
     else:
         obstacle = {"kind": "cylinder", "radius": LY * log_uniform(0.5, 20), "y": rng.uniform(0, LY),
                     "gap": rng.choice([0, LZ * log_uniform(1e-8, 1e-3)])}
-    return {"mesh": {"dims": [ex, ey, ez]}, "box": {"lengths": [LX, LY, LZ], "origin": [0, 0, 0]},
+    return {"mesh": {"dims": [refine * ex, refine * ey, refine * ez]}, "box": {"lengths": [LX, LY, LZ], "origin": [0, 0, 0]},
             "material": {"E": E, "nu": nu}, "loads": loads, "friction": friction, "obstacle": obstacle}
 
 
@@ -93,12 +97,16 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--count", type=int, default=100)
+    ap.add_argument("--refine", type=int, default=1,
+                    help="the same problems on meshes K times finer per axis (K^3 the elements)")
     ap.add_argument("--bin", default="build/bin/tresca")
     ap.add_argument("--compare", help="a second tresca binary, run on the same problems")
     ap.add_argument("--jobs", type=int, default=2, help="runs at a time (each on OMP_NUM_THREADS, default 1)")
     ap.add_argument("--timeout", type=float, default=300)
     ap.add_argument("--keep", help="write the problems and results here (default: a temporary folder)")
     a = ap.parse_args()
+    if a.refine < 1 or a.count < 1:
+        sys.exit("robustness_sweep: --refine and --count must be at least 1")
     binaries = [a.bin] + ([a.compare] if a.compare else [])
     for b in binaries:
         if not os.access(b, os.X_OK):
@@ -110,13 +118,13 @@ def main():
     for k in range(a.count):
         name = os.path.join(folder, f"s{a.seed}_{k:03d}")
         with open(name + ".json", "w") as f:
-            json.dump(draw(rng), f, indent=1)
+            json.dump(draw(rng, a.refine), f, indent=1)
         names.append(name)
     results = []
     for i, b in enumerate(binaries):
         with cf.ThreadPoolExecutor(a.jobs) as ex:
             results.append(list(ex.map(lambda n: solve(b, n + ".json", f"{n}.out{i}.json", a.timeout), names)))
-    print(f"# {a.count} problems, seed {a.seed}, in {folder}; OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS', '1')}")
+    print(f"# {a.count} problems, seed {a.seed}, refine {a.refine}, in {folder}; OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS', '1')}")
     for i, b in enumerate(binaries):
         rows = results[i]
         tally = Counter(r[1] if r[0] in (0, 1) else f"exit {r[0]}" for r in rows)
