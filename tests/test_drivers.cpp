@@ -694,6 +694,25 @@ TEST(TrescaDriver, NewtonThatFailsFromTheCoarseSolutionIsSolvedAgainFromZero) {
   EXPECT_EQ(j["nested"][1]["dims"], nlohmann::json::array({18, 1, 5}));
 }
 
+TEST(TrescaDriver, AFullStepIsTakenWithoutTheEnergyOnlyWhereItHalvesTheLeastResidualSoFar) {
+  // Drawn by perf/robustness_sweep.py --seed 61 (RESULTS.md §0zx; its digits
+  // whole: rounded to 4 the same plate converges either way): a plate
+  // 9x2x12 elements 0.021 m thick pressed on a cylinder, no coarser mesh.
+  // The line search took a full step wherever it halved the last |w|,
+  // whether the energy fell or not; here a full step to 2.6e9-3.4e9 N
+  // followed each short step up to 1.4e10-3.5e10 N, and Newton went back and
+  // forth to the iteration limit. A full step taken so must now halve the
+  // least |w| so far (elsewhere the energy decides): 24 steps when written
+  const std::string json =
+      R"({"mesh": {"dims": [9, 2, 12]}, "box": {"lengths": [4.6533162646603765, 0.2259025713314593, 0.02111304933906387], "origin": [0, 0, 0]},
+          "material": {"E": 372563675380.03046, "nu": 0.003118478115781793},
+          "loads": {"traction": {"z1": [31289094.013167817, -12074306.58082083, -357232445.91390085]}},
+          "friction": {"tresca": 537527141.532372},
+          "obstacle": {"kind": "cylinder", "radius": 0.2801099802757502, "y": 0.011651161921023669, "gap": 0}})";
+  const std::string out = expect_verified_answer("full_step_least", json);
+  EXPECT_LE(newton_steps(out), 35) << out;
+}
+
 TEST(TrescaDriver, StepsSolvedWithTooInexactSProductsAreSolvedAgain) {
   // Drawn by perf/robustness_sweep.py (RESULTS.md §0zt). Plates of elements
   // 220-750 times longer than wide (Coulomb, on a plane and on cylinders):

@@ -412,10 +412,13 @@ void report_progress(const SteklovPoincare& S, const NewtonResult& R, const Poin
 }
 
 // The backtracking line search: with envelope_at, the full step where it
-// halves |w| (Newton's own convergence: the envelope in the metric s,
-// which need not bound S, can rise along a step that cuts |w| by orders of
-// magnitude, and a Coulomb fixed point's Tresca solves stagnated at
-// lengths 2^-8, RESULTS.md §0zs); else the first alpha = 2^-j, j = 0 ..
+// halves the least |w| so far (Newton's own convergence: the envelope in
+// the metric s, which need not bound S, can rise along a step that cuts
+// |w| by orders of magnitude, and a Coulomb fixed point's Tresca solves
+// stagnated at lengths 2^-8, RESULTS.md §0zs; halving the last |w| alone
+// let Newton cycle between two sets of states, |w| 2.0e6 and 6.7e6 N,
+// each full step halving the half step's |w| before it while the energy
+// rose, §0zx); else the first alpha = 2^-j, j = 0 ..
 // halvings, that lowers the forward-backward envelope where envelope_at(alpha)
 // resolves its change, and elsewhere (and without envelope_at) whose
 // merit_at(alpha) <= (1 - 1e-4 alpha) times the largest of the last
@@ -434,7 +437,7 @@ StepLength line_search(const std::vector<real>& merits, int memory, int halvings
   // (the full step's merit, asked once)
   std::optional<real> full;
   auto merit = [&](real alpha) { return alpha == 1 ? (full ? *full : *(full = merit_at(1))) : merit_at(alpha); };
-  if (envelope_at && merit(1) <= 0.5 * merits.back()) return {1, false};
+  if (envelope_at && merit(1) <= 0.5 * *std::min_element(merits.begin(), merits.end())) return {1, false};
   real alpha = 1;
   for (int j = 0; j <= halvings; ++j, alpha *= 0.5) {
     if (const std::optional<real> change = envelope_at ? envelope_at(alpha) : std::nullopt) {
@@ -934,7 +937,7 @@ std::function<std::optional<real>(real)> NewtonSolve::envelope_along_step(const 
   const real* d = du.data();
   const ContactLaw law{x.phi.data(), gap.data(), opt.kink_contact};
   // (du·r, du·S du and |du||r|, at the first length asked: a full step that
-  // halves |w| asks none)
+  // halves the least |w| so far asks none)
   return [=, dots = std::optional<std::array<real, 3>>()](real a) mutable -> std::optional<real> {
     if (!dots)
       dots = {S.sum(dot(n3, d, r)), S.sum(dot(n3, d, Sdu)), std::sqrt(S.sum(dot(n3, d, d)) * S.sum(dot(n3, r, r)))};

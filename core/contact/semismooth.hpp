@@ -172,9 +172,11 @@ struct NewtonOptions {
   // such a merit: a full step that crossed many nodes' kinks could raise
   // the energy while |w| fell, and Newton cycled or crept (a 25x4x7 plate
   // pressed and sheared over a gap: 50 steps, 2e6 N left; with the
-  // envelope 7 steps; RESULTS.md §0zs). A full step that halves |w| is
-  // taken (Newton converging; the envelope in the metric s, which need not
-  // bound S, can rise along it); else a length where the envelope falls;
+  // envelope 7 steps; RESULTS.md §0zs). A full step that halves the least
+  // |w| so far is taken (Newton converging; the envelope in the metric s,
+  // which need not bound S, can rise along it; halving the last |w| alone
+  // let a full step and a short one alternate to the iteration limit,
+  // §0zx); else a length where the envelope falls;
   // where its change is below what its terms resolve
   // (near the solution, and a step that moves only lambda) |w| decides as
   // above. Only where an energy is minimised: the scaled step with a bound
