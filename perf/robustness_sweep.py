@@ -2,7 +2,7 @@
 """Random valid contact problems, each solved by `tresca --problem`: how many converge.
 
 A demanding user's cases are not the seed benchmark: plates and blocks of any
-proportions, elements up to 100 times longer than wide, auxetic to nearly
+proportions, elements up to hundreds of times longer than wide, a tenth over 50:1, auxetic to nearly
 incompressible materials, Tresca bounds from a thousandth to a hundred times
 the mean contact force, Coulomb F up to 3, plane, sphere and cylinder
 obstacles with and without a gap, loads that press, shear and lift. This
