@@ -2,13 +2,13 @@
 """Random valid contact problems, each solved by `tresca --problem`: how many converge.
 
 A demanding user's cases are not the seed benchmark: plates and blocks of any
-proportions, elements up to hundreds of times longer than wide, a tenth over 50:1, auxetic to nearly
-incompressible materials, Tresca bounds from a thousandth to a hundred times
-the mean contact force, Coulomb F up to 3, plane, sphere and cylinder
-obstacles with and without a gap, loads that press, shear and lift. This
-draws such problems (small meshes: a second or less each; --refine K: the
-same problems on meshes K times finer per axis), solves each and
-tallies the outcome by reason. A run that ends without an answer must say
+proportions, elements up to hundreds of times longer than wide (a tenth over
+50:1), auxetic to nearly incompressible materials, Tresca bounds from a
+thousandth to a hundred times the mean contact force, Coulomb F up to 3,
+plane, sphere and cylinder obstacles with and without a gap, loads that
+press, shear and lift. This draws such problems (small meshes: a second or
+less each; --refine K: the same problems on meshes K times finer per axis),
+solves each and tallies the outcome by reason. A run that ends without an answer must say
 so (exit 1 with its reason); exit 2 (bad input) means this generator made an
 invalid problem, and anything else is a defect.
 
